@@ -1,0 +1,1 @@
+//! Histograms drawn with plotters.

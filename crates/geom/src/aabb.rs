@@ -1,0 +1,72 @@
+//! Axis-aligned bounding boxes.
+use crate::P3;
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Aabb {
+    pub min: P3,
+    pub max: P3,
+}
+
+impl Aabb {
+    /// The empty box: grows to the first point added.
+    pub const EMPTY: Aabb = Aabb {
+        min: [f64::INFINITY; 3],
+        max: [f64::NEG_INFINITY; 3],
+    };
+
+    pub fn from_points<'a>(pts: impl IntoIterator<Item = &'a P3>) -> Aabb {
+        let mut b = Aabb::EMPTY;
+        for p in pts {
+            b.grow(*p);
+        }
+        b
+    }
+    #[inline]
+    pub fn grow(&mut self, p: P3) {
+        for k in 0..3 {
+            self.min[k] = self.min[k].min(p[k]);
+            self.max[k] = self.max[k].max(p[k]);
+        }
+    }
+    #[inline]
+    pub fn union(&self, o: &Aabb) -> Aabb {
+        let mut b = *self;
+        for k in 0..3 {
+            b.min[k] = b.min[k].min(o.min[k]);
+            b.max[k] = b.max[k].max(o.max[k]);
+        }
+        b
+    }
+    #[inline]
+    pub fn overlaps(&self, o: &Aabb) -> bool {
+        (0..3).all(|k| self.min[k] <= o.max[k] && o.min[k] <= self.max[k])
+    }
+    #[inline]
+    pub fn contains(&self, p: P3) -> bool {
+        (0..3).all(|k| self.min[k] <= p[k] && p[k] <= self.max[k])
+    }
+    pub fn is_empty(&self) -> bool {
+        self.min[0] > self.max[0]
+    }
+    pub fn diagonal(&self) -> f64 {
+        if self.is_empty() {
+            0.0
+        } else {
+            crate::vec3::dist(self.min, self.max)
+        }
+    }
+    pub fn center(&self) -> P3 {
+        [
+            0.5 * (self.min[0] + self.max[0]),
+            0.5 * (self.min[1] + self.max[1]),
+            0.5 * (self.min[2] + self.max[2]),
+        ]
+    }
+    /// Grown by `d` on every side.
+    pub fn inflated(&self, d: f64) -> Aabb {
+        Aabb {
+            min: [self.min[0] - d, self.min[1] - d, self.min[2] - d],
+            max: [self.max[0] + d, self.max[1] + d, self.max[2] + d],
+        }
+    }
+}

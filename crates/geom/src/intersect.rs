@@ -1,0 +1,1 @@
+//! Exact intersection tests between segments and triangles.

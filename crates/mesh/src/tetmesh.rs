@@ -1,0 +1,25 @@
+use crate::ids::*;
+use parafront_geom::P3;
+
+/// Local faces of a tet, each listed so that its right-hand normal points
+/// out of a positively oriented tet. Face `f` is opposite vertex `f`.
+pub const TET_FACES: [[usize; 3]; 4] = [[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]];
+
+/// A tetrahedral mesh: geometry (`points`) apart from topology (`tets`,
+/// `neigh`), plus per-tet regions and the tagged boundary triangles.
+#[derive(Clone, Debug, Default)]
+pub struct TetMesh {
+    /// Coordinates, indexed by [`PointId`].
+    pub points: Vec<P3>,
+    /// Four point ids per tet, positively oriented.
+    pub tets: Vec<[PointId; 4]>,
+    /// `neigh[4t+f]`: the face on the other side of face `f` of tet `t`, or
+    /// [`NO_FACE`]. Empty until `build_adjacency` runs.
+    pub neigh: Vec<FaceRef>,
+    /// Region id per tet (0 when the domain has one region).
+    pub region: Vec<u32>,
+    /// Boundary triangles (outward, i.e. as in the input surface) with their
+    /// patch tags; carried through to output.
+    pub bnd_tris: Vec<[PointId; 3]>,
+    pub bnd_patch: Vec<u32>,
+}

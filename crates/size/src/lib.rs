@@ -1,0 +1,1 @@
+//! The size field (paper AG1).
