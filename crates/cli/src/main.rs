@@ -1,2 +1,331 @@
+//! `parafront`: the command line. A thin layer: each subcommand parses its
+//! flags into the library's option structs and calls one function.
 mod plot;
-fn main() {}
+
+use clap::{Args, Parser, Subcommand};
+use parafront_io::{read_mesh, write_mesh, MshVersion, WriteOptions};
+use parafront_mesh::QualityReport;
+use parafront_pipeline::{mesh_surface, MeshError, MeshOptions, Summary};
+use parafront_surface::read::read_surface;
+use parafront_surface::validate::validate;
+use parafront_surface::Surface;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::time::Instant;
+
+#[derive(Parser)]
+#[command(
+    name = "parafront",
+    version,
+    about = "Parallel advancing-front tetrahedral mesh generator (after Löhner 2014)"
+)]
+struct Cli {
+    #[command(subcommand)]
+    cmd: Cmd,
+}
+
+#[derive(Subcommand)]
+enum Cmd {
+    /// Mesh the built-in demo part (a block with a drilled hole, a void
+    /// and an embedded torus) and write it.
+    Demo {
+        /// Output mesh (.vtu, .msh, .mesh).
+        #[arg(short, long, default_value = "demo.vtu")]
+        output: PathBuf,
+        #[command(flatten)]
+        mesh: MeshArgs,
+        #[command(flatten)]
+        write: WriteArgs,
+    },
+    /// Mesh the volume bounded by a closed surface (STL, OBJ, OFF, .msh, .mesh).
+    Mesh {
+        surface: PathBuf,
+        /// Output mesh (.vtu, .msh, .mesh).
+        #[arg(short, long)]
+        output: PathBuf,
+        #[command(flatten)]
+        mesh: MeshArgs,
+        #[command(flatten)]
+        write: WriteArgs,
+    },
+    /// Validate a surface: open, non-manifold, inconsistent orientation,
+    /// degenerate, duplicate and self-intersecting triangles; shell nesting.
+    /// Exit status 0 when it can be meshed.
+    Check { surface: PathBuf },
+    /// Quality statistics of a tet mesh, optionally plotted (.svg or .png).
+    Quality {
+        mesh: PathBuf,
+        #[arg(long)]
+        plot: Option<PathBuf>,
+    },
+    /// Convert a tet mesh between formats (.vtu, .msh, .mesh).
+    Convert {
+        input: PathBuf,
+        output: PathBuf,
+        #[command(flatten)]
+        write: WriteArgs,
+    },
+}
+
+#[derive(Args)]
+struct MeshArgs {
+    /// Target element size (also the largest size).
+    #[arg(long)]
+    size: Option<f64>,
+    /// Smallest element size.
+    #[arg(long)]
+    hmin: Option<f64>,
+    /// Largest element size.
+    #[arg(long)]
+    hmax: Option<f64>,
+    /// Growth limit of the size away from the surface and sources (>= 1).
+    #[arg(long)]
+    gradation: Option<f64>,
+    /// Size options from a TOML file (sources, per-patch sizes, ...);
+    /// the flags above override it.
+    #[arg(long)]
+    size_file: Option<PathBuf>,
+    /// Worker threads (default: all cores).
+    #[arg(long)]
+    threads: Option<usize>,
+    /// Also plot the quality histograms to this file (.svg or .png).
+    #[arg(long)]
+    plot: Option<PathBuf>,
+}
+
+#[derive(Args)]
+struct WriteArgs {
+    /// Gmsh output version: 4.1 or 2.2.
+    #[arg(long, default_value = "4.1")]
+    msh_version: String,
+    /// Binary Gmsh output.
+    #[arg(long)]
+    binary: bool,
+    /// Uncompressed VTU output.
+    #[arg(long)]
+    no_compress: bool,
+}
+
+/// A failure with its exit status: 1 for a bad surface or mesh, 2 for
+/// unreadable input and bad options.
+struct Fail(u8, String);
+
+impl<E: std::fmt::Display> From<E> for Fail {
+    fn from(e: E) -> Fail {
+        Fail(2, e.to_string())
+    }
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let res = match cli.cmd {
+        Cmd::Demo {
+            output,
+            mesh,
+            write,
+        } => {
+            let s = parafront_surface::generate::demo_part();
+            println!("demo part: block 16x12x6 mm with a drilled hole, a spherical void and an embedded torus");
+            run_mesh(&s, "demo part", &output, &mesh, &write)
+        }
+        Cmd::Mesh {
+            surface,
+            output,
+            mesh,
+            write,
+        } => read_surface(&surface)
+            .map_err(Fail::from)
+            .and_then(|s| run_mesh(&s, &surface.display().to_string(), &output, &mesh, &write)),
+        Cmd::Check { surface } => run_check(&surface),
+        Cmd::Quality { mesh, plot } => run_quality(&mesh, plot.as_deref()),
+        Cmd::Convert {
+            input,
+            output,
+            write,
+        } => run_convert(&input, &output, &write),
+    };
+    match res {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(Fail(code, msg)) => {
+            eprintln!("parafront: {msg}");
+            ExitCode::from(code)
+        }
+    }
+}
+
+fn write_options(w: &WriteArgs, s: Option<&Surface>) -> Result<WriteOptions, Fail> {
+    let msh_version = match w.msh_version.as_str() {
+        "4.1" | "4" => MshVersion::V41,
+        "2.2" | "2" => MshVersion::V22,
+        v => return Err(Fail(2, format!("--msh-version {v}: expected 4.1 or 2.2"))),
+    };
+    Ok(WriteOptions {
+        msh_version,
+        binary: w.binary,
+        compress: !w.no_compress,
+        patch_names: s.map(|s| s.patch_names.clone()).unwrap_or_default(),
+        ..Default::default()
+    })
+}
+
+fn mesh_options(a: &MeshArgs) -> Result<MeshOptions, Fail> {
+    let mut o = MeshOptions::default();
+    if let Some(f) = &a.size_file {
+        o.size = parafront_size::SizeOptions::from_toml_file(f)?;
+    }
+    if a.size.is_some() {
+        o.size.h = a.size;
+    }
+    if let Some(v) = a.hmin {
+        o.size.hmin = v;
+    }
+    if let Some(v) = a.hmax {
+        o.size.hmax = v;
+    }
+    if let Some(v) = a.gradation {
+        o.size.gradation = v;
+    }
+    o.threads = a.threads.unwrap_or(0);
+    Ok(o)
+}
+
+fn run_mesh(s: &Surface, name: &str, out: &Path, a: &MeshArgs, w: &WriteArgs) -> Result<(), Fail> {
+    let opts = mesh_options(a)?;
+    let wopts = write_options(w, Some(s))?;
+    if parafront_io::Format::from_path(out).is_none() {
+        return Err(Fail(
+            2,
+            format!(
+                "{}: unknown output format (use .vtu, .msh or .mesh)",
+                out.display()
+            ),
+        ));
+    }
+    if opts.threads > 0 {
+        // Only the first call can set the pool; later ones keep it.
+        let _ = rayon::ThreadPoolBuilder::new()
+            .num_threads(opts.threads)
+            .build_global();
+    }
+    println!(
+        "{name}: {} points, {} triangles",
+        s.points.len(),
+        s.tris.len()
+    );
+    let (mesh, mut sum) = mesh_surface(s, &opts).map_err(|e| match e {
+        MeshError::InvalidSurface(_) => Fail(1, format!("{name}: {e}")),
+        e => Fail(1, format!("{name}: {e}")),
+    })?;
+    let t0 = Instant::now();
+    write_mesh(out, &mesh, &wopts)?;
+    sum.stages.push(("write", t0.elapsed().as_secs_f64()));
+    let q = parafront_pipeline::quality_report(&mesh, s, &opts);
+    print_summary(&sum, &q);
+    println!("wrote {}", out.display());
+    if let Some(p) = &a.plot {
+        plot::plot_histograms(&q, None, p)?;
+        println!("wrote {}", p.display());
+    }
+    Ok(())
+}
+
+fn print_summary(sum: &Summary, q: &QualityReport) {
+    let front = sum.seconds("front");
+    println!(
+        "{} tets, {} points, {} region{}",
+        sum.tets,
+        sum.points,
+        sum.regions,
+        if sum.regions == 1 { "" } else { "s" }
+    );
+    let stages: Vec<String> = sum
+        .stages
+        .iter()
+        .map(|(n, s)| format!("{n} {s:.3}"))
+        .collect();
+    println!(
+        "seconds: {} (total {:.3})",
+        stages.join(", "),
+        sum.total_seconds()
+    );
+    if front > 0.0 {
+        println!("front: {:.0} tets/s", sum.tets as f64 / front);
+    }
+    if sum.recovery_rounds > 0 {
+        println!(
+            "recovery: {} rounds, {} tets removed and re-meshed",
+            sum.recovery_rounds, sum.tets_removed
+        );
+    }
+    if let Some(m) = peak_memory_bytes() {
+        println!(
+            "peak memory: {:.1} MiB ({:.0} bytes/tet)",
+            m as f64 / 1048576.0,
+            m as f64 / sum.tets.max(1) as f64
+        );
+    }
+    println!(
+        "quality: min dihedral {:.2} deg, {:.3}% of tets under 10 deg, mean radius ratio {:.3}",
+        q.min_dihedral.min,
+        100.0 * q.share_min_dihedral_below,
+        q.radius_ratio.mean
+    );
+}
+
+/// Peak resident memory (VmHWM) on Linux.
+fn peak_memory_bytes() -> Option<u64> {
+    let s = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = s.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024)
+}
+
+fn run_check(path: &Path) -> Result<(), Fail> {
+    let t0 = Instant::now();
+    let s = read_surface(path)?;
+    let report = validate(&s);
+    println!("{}: {}", path.display(), report);
+    println!("checked in {:.3} s", t0.elapsed().as_secs_f64());
+    if report.is_valid() {
+        Ok(())
+    } else {
+        Err(Fail(
+            1,
+            format!("{}: the surface is not valid for meshing", path.display()),
+        ))
+    }
+}
+
+fn run_quality(path: &Path, plot_to: Option<&Path>) -> Result<(), Fail> {
+    let mesh = read_mesh(path)?;
+    if let Err(e) = mesh.check() {
+        println!("warning: {}: {e}", path.display());
+    }
+    let q = QualityReport::new(&mesh);
+    println!(
+        "{}: {} points, {} tets",
+        path.display(),
+        mesh.points.len(),
+        mesh.tets.len()
+    );
+    println!("{q}");
+    if let Some(p) = plot_to {
+        plot::plot_histograms(&q, None, p)?;
+        println!("wrote {}", p.display());
+    }
+    Ok(())
+}
+
+fn run_convert(input: &Path, output: &Path, w: &WriteArgs) -> Result<(), Fail> {
+    let mesh = read_mesh(input)?;
+    write_mesh(output, &mesh, &write_options(w, None)?)?;
+    println!(
+        "{} -> {}: {} points, {} tets, {} boundary triangles",
+        input.display(),
+        output.display(),
+        mesh.points.len(),
+        mesh.tets.len(),
+        mesh.bnd_tris.len()
+    );
+    Ok(())
+}

@@ -7,9 +7,22 @@
 //!
 //! Orientation: every tet `abcd` has `orient3d(a,b,c,d) > 0`, and face `f`
 //! listed by [`TET_FACES`] has its right-hand normal pointing out of the tet.
+//!
+//! - `build_adjacency`, `boundary_faces`: pairing faces by a sorted table.
+//! - `check`, `check_against_surface`: all invariants, exact orientation.
+//! - [`quality`]: dihedral angles, radius and mean ratio, edge length vs size.
+//! - [`generate`]: structured box meshes for tests.
 
+mod adjacency;
+mod check;
+mod faces;
+pub mod generate;
 pub mod ids;
+pub mod quality;
 mod tetmesh;
 
+pub use adjacency::{TopoError, MAX_TETS};
+pub use check::{CheckError, CheckStats, MeshProblem, ProblemKind, SAMPLES, VOLUME_RTOL};
 pub use ids::{FaceRef, PointId, TetId, NO_FACE};
+pub use quality::{QualityReport, TetQuality};
 pub use tetmesh::{TetMesh, TET_FACES};

@@ -23,3 +23,37 @@ pub struct TetMesh {
     pub bnd_tris: Vec<[PointId; 3]>,
     pub bnd_patch: Vec<u32>,
 }
+
+impl TetMesh {
+    pub fn n_points(&self) -> usize {
+        self.points.len()
+    }
+    pub fn n_tets(&self) -> usize {
+        self.tets.len()
+    }
+    /// Coordinates of the four vertices of tet `t`.
+    #[inline]
+    pub fn tet_points(&self, t: TetId) -> [P3; 4] {
+        self.tets[t.idx()].map(|p| self.points[p.idx()])
+    }
+    /// Region of tet `t` (0 when `region` is empty).
+    #[inline]
+    pub fn region_of(&self, t: TetId) -> u32 {
+        self.region.get(t.idx()).copied().unwrap_or(0)
+    }
+    /// Appends a point and returns its id.
+    pub fn push_point(&mut self, p: P3) -> PointId {
+        self.points.push(p);
+        PointId::new(self.points.len() - 1)
+    }
+    /// Appends a tet with its region; invalidates `neigh` (cleared).
+    pub fn push_tet(&mut self, verts: [PointId; 4], region: u32) -> TetId {
+        self.neigh.clear();
+        if self.region.len() < self.tets.len() {
+            self.region.resize(self.tets.len(), 0);
+        }
+        self.tets.push(verts);
+        self.region.push(region);
+        TetId::new(self.tets.len() - 1)
+    }
+}

@@ -5,6 +5,7 @@
 //! - [`validate`]: open / non-manifold / orientation / degenerate /
 //!   self-intersection checks, and how the closed shells nest.
 
+pub mod generate;
 pub mod read;
 pub mod validate;
 

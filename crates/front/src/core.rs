@@ -1,0 +1,765 @@
+//! The front loop: AF1 (smallest face first), AF2 (ideal point, close
+//! points, crossing checks), AF3 (add the tet), AF4 (sizes of new points),
+//! AF5 (matching faces leave the front), and the recovery path for a front
+//! that gets stuck.
+use crate::grid::LooseGrid;
+use crate::quality::candidate_score;
+use crate::{RegionFilter, SizeMode};
+use parafront_geom::intersect::triangles_intersect;
+use parafront_geom::*;
+use parafront_mesh::TET_FACES;
+use rustc_hash::FxHashMap;
+use std::cmp::Reverse;
+use std::collections::BinaryHeap;
+
+const NONE: u32 = u32::MAX;
+
+/// Tuning of the front. The defaults are what the serial mesher uses.
+#[derive(Clone, Debug)]
+pub struct FrontOptions {
+    /// Attempts on one face before it waits for recovery.
+    pub tries_per_face: u8,
+    /// Removal-and-remesh rounds before giving up (step 5 of the issue).
+    pub recovery_rounds: u32,
+    /// Stop with an error past this many points (runaway guard).
+    pub max_points: usize,
+    /// Report progress every this many tets (0: never).
+    pub progress_every: usize,
+}
+
+impl Default for FrontOptions {
+    fn default() -> Self {
+        FrontOptions {
+            tries_per_face: 3,
+            recovery_rounds: 40,
+            max_points: u32::MAX as usize - 1,
+            progress_every: 0,
+        }
+    }
+}
+
+/// A closed front to fill.
+pub struct FrontInput {
+    pub points: Vec<P3>,
+    /// Size at each point (AG3).
+    pub point_size: Vec<f64>,
+    /// Triangles with right-hand normals pointing into the region to mesh.
+    pub faces: Vec<[u32; 3]>,
+}
+
+#[derive(Clone, Debug, Default)]
+pub struct FrontStats {
+    pub tets: usize,
+    pub new_points: usize,
+    pub retries: usize,
+    pub recovery_rounds: u32,
+    pub tets_removed: usize,
+}
+
+/// What the front made.
+#[derive(Debug)]
+pub struct FrontResult {
+    /// Input points first, in input order, then the new points.
+    pub points: Vec<P3>,
+    pub point_size: Vec<f64>,
+    /// Positively oriented tets.
+    pub tets: Vec<[u32; 4]>,
+    /// `neigh[4t+f] = 4t'+f'` or `u32::MAX`.
+    pub neigh: Vec<u32>,
+    /// Faces the region filter kept from being advanced (pass hand-over).
+    pub front: Vec<[u32; 3]>,
+    pub stats: FrontStats,
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum FrontError {
+    #[error("the front could not be closed after {rounds} recovery rounds: {faces} faces stuck near ({x:.6e}, {y:.6e}, {z:.6e})")]
+    Stuck {
+        rounds: u32,
+        faces: usize,
+        x: f64,
+        y: f64,
+        z: f64,
+    },
+    #[error(
+        "the front is not closed: edge ({a}, {b}) is used by {count} faces with this direction"
+    )]
+    OpenFront { a: u32, b: u32, count: usize },
+    #[error("more than {0} points: the size field or the front is running away")]
+    TooManyPoints(usize),
+}
+
+enum Outcome {
+    Placed,
+    Failed,
+    Prohibited,
+}
+
+#[derive(Clone, Copy)]
+struct Near {
+    id: u32,
+    v: [u32; 3],
+    bb: Aabb,
+}
+
+struct Front<'a> {
+    pts: Vec<P3>,
+    hp: Vec<f64>,
+    n_input: usize,
+    fv: Vec<[u32; 3]>,
+    falive: Vec<bool>,
+    fowner: Vec<u32>,
+    ftries: Vec<u8>,
+    fmap: FxHashMap<[u32; 3], u32>,
+    heap: BinaryHeap<Reverse<(u64, u32)>>,
+    pcount: Vec<u32>,
+    pgrid: LooseGrid,
+    fgrid: LooseGrid,
+    tets: Vec<[u32; 4]>,
+    neigh: Vec<u32>,
+    talive: Vec<bool>,
+    stuck: Vec<u32>,
+    prohibited: Vec<u32>,
+    relax: u32,
+    opts: &'a FrontOptions,
+    region: &'a dyn RegionFilter,
+    size: SizeMode<'a>,
+    stats: FrontStats,
+    // Scratch buffers, reused for every face.
+    near_f: Vec<Near>,
+    near_p: Vec<u32>,
+    cands: Vec<(f64, u32)>,
+}
+
+#[inline]
+fn sorted3(v: [u32; 3]) -> [u32; 3] {
+    let mut k = v;
+    k.sort_unstable();
+    k
+}
+
+#[inline]
+fn same_cycle(a: [u32; 3], b: [u32; 3]) -> bool {
+    a == b || a == [b[1], b[2], b[0]] || a == [b[2], b[0], b[1]]
+}
+
+/// Both triangles reordered so their common vertices come first, in the
+/// same order (what `triangles_intersect` expects).
+#[inline]
+fn shared_first(a: [u32; 3], ap: [P3; 3], b: [u32; 3], bp: [P3; 3]) -> ([P3; 3], [P3; 3]) {
+    let (mut oa, mut ob) = ([0usize; 3], [0usize; 3]);
+    let (mut ua, mut ub) = ([false; 3], [false; 3]);
+    let mut n = 0;
+    for i in 0..3 {
+        for j in 0..3 {
+            if a[i] == b[j] {
+                oa[n] = i;
+                ob[n] = j;
+                ua[i] = true;
+                ub[j] = true;
+                n += 1;
+            }
+        }
+    }
+    let (mut ka, mut kb) = (n, n);
+    for i in 0..3 {
+        if !ua[i] {
+            oa[ka] = i;
+            ka += 1;
+        }
+        if !ub[i] {
+            ob[kb] = i;
+            kb += 1;
+        }
+    }
+    (oa.map(|i| ap[i]), ob.map(|j| bp[j]))
+}
+
+fn tri_box(p: &[P3], v: [u32; 3]) -> Aabb {
+    let mut b = Aabb::EMPTY;
+    for &i in &v {
+        b.grow(p[i as usize]);
+    }
+    b
+}
+
+/// Fill the region bounded by `input.faces` (paper AF1-AF5).
+pub fn advance(
+    input: FrontInput,
+    size: SizeMode<'_>,
+    region: &dyn RegionFilter,
+    opts: &FrontOptions,
+) -> Result<FrontResult, FrontError> {
+    check_closed(&input.faces)?;
+    let n = input.points.len();
+    let bb = Aabb::from_points(&input.points);
+    let hmin = input
+        .point_size
+        .iter()
+        .copied()
+        .filter(|h| *h > 0.0 && h.is_finite())
+        .fold(f64::INFINITY, f64::min);
+    let s0 = if hmin.is_finite() {
+        hmin
+    } else {
+        bb.diagonal().max(1e-300) * 1e-3
+    };
+    let mut f = Front {
+        pts: input.points,
+        hp: input.point_size,
+        n_input: n,
+        fv: Vec::new(),
+        falive: Vec::new(),
+        fowner: Vec::new(),
+        ftries: Vec::new(),
+        fmap: FxHashMap::default(),
+        heap: BinaryHeap::new(),
+        pcount: vec![0; n],
+        pgrid: LooseGrid::new(s0, bb.min),
+        fgrid: LooseGrid::new(s0, bb.min),
+        tets: Vec::new(),
+        neigh: Vec::new(),
+        talive: Vec::new(),
+        stuck: Vec::new(),
+        prohibited: Vec::new(),
+        relax: 0,
+        opts,
+        region,
+        size,
+        stats: FrontStats::default(),
+        near_f: Vec::new(),
+        near_p: Vec::new(),
+        cands: Vec::new(),
+    };
+    if let SizeMode::Growth(c) = size {
+        // §5: initial face sizes are multiplied by the growth factor.
+        for h in &mut f.hp {
+            *h *= c;
+        }
+    }
+    for v in input.faces {
+        f.add_face(v, NONE);
+    }
+    f.run()?;
+    Ok(f.finish())
+}
+
+/// Every directed edge of a closed front appears exactly once, and its
+/// reverse once.
+fn check_closed(faces: &[[u32; 3]]) -> Result<(), FrontError> {
+    let mut e: Vec<(u32, u32)> = Vec::with_capacity(faces.len() * 3);
+    for v in faces {
+        for k in 0..3 {
+            e.push((v[k], v[(k + 1) % 3]));
+        }
+    }
+    e.sort_unstable();
+    let mut i = 0;
+    while i < e.len() {
+        let mut j = i + 1;
+        while j < e.len() && e[j] == e[i] {
+            j += 1;
+        }
+        let (a, b) = e[i];
+        let rev = e.binary_search(&(b, a)).is_ok();
+        if j - i > 1 || !rev {
+            return Err(FrontError::OpenFront { a, b, count: j - i });
+        }
+        i = j;
+    }
+    Ok(())
+}
+
+impl<'a> Front<'a> {
+    fn face_key(&self, v: [u32; 3]) -> f64 {
+        // AF1: the face forming the smallest element goes first.
+        let h = (self.hp[v[0] as usize] + self.hp[v[1] as usize] + self.hp[v[2] as usize]) / 3.0;
+        let p = |i: usize| self.pts[v[i] as usize];
+        let e = dist2(p(0), p(1))
+            .max(dist2(p(1), p(2)))
+            .max(dist2(p(2), p(0)))
+            .sqrt();
+        h.min(e)
+    }
+
+    fn add_face(&mut self, v: [u32; 3], owner: u32) {
+        let id = self.fv.len() as u32;
+        self.fv.push(v);
+        self.falive.push(true);
+        self.fowner.push(owner);
+        self.ftries.push(0);
+        self.fmap.insert(sorted3(v), id);
+        for &p in &v {
+            let c = &mut self.pcount[p as usize];
+            *c += 1;
+            if *c == 1 {
+                self.pgrid
+                    .insert(p, self.pts[p as usize], self.hp[p as usize]);
+            }
+        }
+        let bb = tri_box(&self.pts, v);
+        let ext = (0..3).map(|k| bb.max[k] - bb.min[k]).fold(0.0, f64::max);
+        self.fgrid.insert(id, bb.center(), ext);
+        let key = self.face_key(v);
+        self.heap.push(Reverse((key.to_bits(), id)));
+    }
+
+    fn remove_face(&mut self, id: u32) {
+        let i = id as usize;
+        debug_assert!(self.falive[i]);
+        self.falive[i] = false;
+        let v = self.fv[i];
+        self.fmap.remove(&sorted3(v));
+        self.fgrid.remove(id);
+        for &p in &v {
+            let c = &mut self.pcount[p as usize];
+            *c -= 1;
+            if *c == 0 {
+                self.pgrid.remove(p);
+            }
+        }
+    }
+
+    fn run(&mut self) -> Result<(), FrontError> {
+        loop {
+            while let Some(Reverse((key, fid))) = self.heap.pop() {
+                if !self.falive[fid as usize] {
+                    continue;
+                }
+                match self.try_face(fid) {
+                    Outcome::Placed => {
+                        if self.pts.len() > self.opts.max_points {
+                            return Err(FrontError::TooManyPoints(self.opts.max_points));
+                        }
+                    }
+                    Outcome::Prohibited => self.prohibited.push(fid),
+                    Outcome::Failed => {
+                        self.stats.retries += 1;
+                        let t = &mut self.ftries[fid as usize];
+                        *t += 1;
+                        if *t < self.opts.tries_per_face {
+                            // Later, when its surroundings have changed.
+                            let k = f64::from_bits(key) * 1.5;
+                            self.heap.push(Reverse((k.to_bits(), fid)));
+                        } else {
+                            self.stuck.push(fid);
+                        }
+                    }
+                }
+            }
+            self.stuck.retain(|&f| self.falive[f as usize]);
+            if self.stuck.is_empty() {
+                return Ok(());
+            }
+            if self.relax >= self.opts.recovery_rounds {
+                let f = self.stuck[0];
+                let v = self.fv[f as usize];
+                let c = centroid3(
+                    self.pts[v[0] as usize],
+                    self.pts[v[1] as usize],
+                    self.pts[v[2] as usize],
+                );
+                return Err(FrontError::Stuck {
+                    rounds: self.relax,
+                    faces: self.stuck.len(),
+                    x: c[0],
+                    y: c[1],
+                    z: c[2],
+                });
+            }
+            self.recover();
+        }
+    }
+
+    /// Recovery: remove the tets around the stuck faces, one growing layer
+    /// per round, then re-mesh the hole with relaxed acceptance.
+    fn recover(&mut self) {
+        self.relax += 1;
+        self.stats.recovery_rounds = self.relax;
+        let layers = 1 + (self.relax as usize - 1) / 2;
+        let mut mark = vec![false; self.pts.len()];
+        for &f in &self.stuck {
+            for &p in &self.fv[f as usize] {
+                mark[p as usize] = true;
+            }
+        }
+        let mut removed = Vec::new();
+        for _ in 0..layers {
+            let mut layer = Vec::new();
+            for (t, tv) in self.tets.iter().enumerate() {
+                if self.talive[t] && tv.iter().any(|&p| mark[p as usize]) {
+                    layer.push(t as u32);
+                }
+            }
+            for &t in &layer {
+                self.talive[t as usize] = false;
+            }
+            for &t in &layer {
+                for &p in &self.tets[t as usize] {
+                    mark[p as usize] = true;
+                }
+            }
+            removed.extend(layer);
+        }
+        for &t in &removed {
+            self.unlink_tet(t);
+        }
+        self.stats.tets_removed += removed.len();
+        // Every face of the front gets another go, relaxed.
+        self.stuck.clear();
+        for id in 0..self.fv.len() {
+            if self.falive[id] {
+                self.ftries[id] = 0;
+                let key = self.face_key(self.fv[id]);
+                self.heap.push(Reverse((key.to_bits(), id as u32)));
+            }
+        }
+    }
+
+    /// Take dead tet `t` out: its faces towards live tets or the input
+    /// surface join the front, its front faces leave it.
+    fn unlink_tet(&mut self, t: u32) {
+        let tv = self.tets[t as usize];
+        for i in 0..4 {
+            let fr = 4 * t + i as u32;
+            let w = TET_FACES[i].map(|k| tv[k]);
+            let nb = self.neigh[fr as usize];
+            if nb != NONE {
+                // A dead neighbour leaves nothing behind: the hole spans both.
+                let u = nb >> 2;
+                if self.talive[u as usize] {
+                    self.neigh[nb as usize] = NONE;
+                    let uv = self.tets[u as usize];
+                    let fw = TET_FACES[(nb & 3) as usize].map(|k| uv[k]);
+                    self.add_face(fw, nb);
+                }
+                continue;
+            }
+            match self.fmap.get(&sorted3(w)) {
+                Some(&g) if self.fowner[g as usize] == fr => self.remove_face(g),
+                found => {
+                    // An input face: it faces the hole again.
+                    debug_assert!(found.is_none(), "face {w:?} twice in the front");
+                    self.add_face([w[0], w[2], w[1]], NONE);
+                }
+            }
+        }
+    }
+
+    fn new_point_size(&self, v: [u32; 3], p: P3) -> f64 {
+        match self.size {
+            SizeMode::Field(f) => f(p),
+            SizeMode::Growth(c) => {
+                c * (self.hp[v[0] as usize] + self.hp[v[1] as usize] + self.hp[v[2] as usize]) / 3.0
+            }
+        }
+    }
+
+    fn try_face(&mut self, fid: u32) -> Outcome {
+        let v = self.fv[fid as usize];
+        let [pa, pb, pc] = v.map(|i| self.pts[i as usize]);
+        // §7: a face with a point or an edge outside the region is skipped.
+        if !(self.region.point_ok(pa) && self.region.point_ok(pb) && self.region.point_ok(pc)) {
+            return Outcome::Prohibited;
+        }
+        if !(self.region.edge_ok(pa, pb)
+            && self.region.edge_ok(pb, pc)
+            && self.region.edge_ok(pc, pa))
+        {
+            return Outcome::Prohibited;
+        }
+        let nrm = normalize(tri_normal(pa, pb, pc));
+        let m = centroid3(pa, pb, pc);
+        let h = (self.hp[v[0] as usize] + self.hp[v[1] as usize] + self.hp[v[2] as usize]) / 3.0;
+        let dm = (dist(m, pa) + dist(m, pb) + dist(m, pc)) / 3.0;
+        let emax = dist(pa, pb).max(dist(pb, pc)).max(dist(pc, pa));
+        // AF2.1: the ideal point sits at a regular tet's height.
+        let alpha = (h * h - dm * dm).max(0.25 * dm * dm).sqrt();
+        let pstar = add(m, scale(nrm, alpha));
+        let star_ok = self.region.point_ok(pstar);
+        if !star_ok {
+            return Outcome::Prohibited;
+        }
+        // AF2.2: close points and faces, from one box holding every
+        // candidate tet.
+        let relax = self.relax.min(6) as f64;
+        let r = h.max(emax) * (1.0 + 0.35 * relax + 0.25 * self.ftries[fid as usize] as f64);
+        let cq = add(m, scale(nrm, 0.5 * alpha));
+        let qbox = Aabb { min: cq, max: cq }
+            .inflated(r)
+            .union(&tri_box(&self.pts, v));
+        let mut near_p = std::mem::take(&mut self.near_p);
+        let mut near_f = std::mem::take(&mut self.near_f);
+        let mut cands = std::mem::take(&mut self.cands);
+        near_p.clear();
+        near_f.clear();
+        cands.clear();
+        self.pgrid.query(&qbox, |p| near_p.push(p));
+        self.fgrid.query(&qbox, |g| {
+            if g != fid {
+                near_f.push(Near {
+                    id: g,
+                    v: self.fv[g as usize],
+                    bb: tri_box(&self.pts, self.fv[g as usize]),
+                })
+            }
+        });
+        // Sort for a deterministic order whatever the grid's layout.
+        near_p.sort_unstable();
+        near_f.sort_unstable_by_key(|n| n.id);
+        let mut star_clear = true;
+        let too_close = 0.55 * h;
+        for &q in &near_p {
+            if v.contains(&q) {
+                continue;
+            }
+            let pq = self.pts[q as usize];
+            if dist2(pq, pstar) < too_close * too_close {
+                star_clear = false;
+            }
+            if !self.region.point_ok(pq) {
+                continue; // §7: a close point outside the region is dropped
+            }
+            if orient3d(pa, pb, pc, pq) <= 0.0 {
+                continue;
+            }
+            let (shape, mut score) = candidate_score(pa, pb, pc, pq, h);
+            if shape <= 0.0 {
+                continue;
+            }
+            if dist2(pq, pstar) < too_close * too_close {
+                score += 1.0; // prefer an existing point near the ideal one
+            }
+            cands.push((score, q));
+        }
+        // New points: the ideal one, and lower ones once a face has failed
+        // (a narrow gap has room for a flat tet only). Id NONE - k codes
+        // height k.
+        let tries = self.ftries[fid as usize] as u32 + self.relax;
+        let heights: &[f64] = if tries == 0 {
+            &[1.0]
+        } else {
+            &[1.0, 0.7, 0.45, 0.25]
+        };
+        for (k, &hf) in heights.iter().enumerate() {
+            let p = add(m, scale(nrm, alpha * hf));
+            let clear = if k == 0 {
+                star_clear
+            } else {
+                let lim = too_close * hf;
+                near_p
+                    .iter()
+                    .all(|&q| v.contains(&q) || dist2(self.pts[q as usize], p) >= lim * lim)
+            };
+            if clear && self.region.point_ok(p) {
+                let (_, score) = candidate_score(pa, pb, pc, p, h);
+                cands.push((score * (1.0 - 0.1 * k as f64), NONE - k as u32));
+            }
+        }
+        cands.sort_unstable_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
+        let min_score = match self.relax + self.ftries[fid as usize] as u32 {
+            0 => 0.12,
+            1 => 0.05,
+            2 => 0.01,
+            _ => 0.0,
+        };
+        let mut placed = None;
+        for &(score, q) in &cands {
+            let s = if score >= 1.0 { score - 1.0 } else { score };
+            if s < min_score {
+                break;
+            }
+            let pq = if q >= NONE - 3 {
+                add(
+                    m,
+                    scale(nrm, alpha * [1.0, 0.7, 0.45, 0.25][(NONE - q) as usize]),
+                )
+            } else {
+                self.pts[q as usize]
+            };
+            if self.tet_is_free(v, q, pq, &near_f, &near_p) {
+                placed = Some((q, pq));
+                break;
+            }
+        }
+        self.near_p = near_p;
+        self.near_f = near_f;
+        self.cands = cands;
+        match placed {
+            Some((q, pq)) => {
+                self.commit(fid, q, pq);
+                Outcome::Placed
+            }
+            None => Outcome::Failed,
+        }
+    }
+
+    /// AF2.3: tet `v + q` must cross no front face and hold no front point.
+    fn tet_is_free(&self, v: [u32; 3], q: u32, pq: P3, near_f: &[Near], near_p: &[u32]) -> bool {
+        let tv = [v[0], v[1], v[2], q];
+        let tp = [
+            self.pts[v[0] as usize],
+            self.pts[v[1] as usize],
+            self.pts[v[2] as usize],
+            pq,
+        ];
+        let mut tb = Aabb::EMPTY;
+        for p in tp {
+            tb.grow(p);
+        }
+        let new_faces: [[usize; 3]; 3] = [TET_FACES[0], TET_FACES[1], TET_FACES[2]];
+        for nf in near_f {
+            if !nf.bb.overlaps(&tb) {
+                continue;
+            }
+            let g = nf.v;
+            let gp = g.map(|i| self.pts[i as usize]);
+            for lf in &new_faces {
+                let fvid = lf.map(|k| tv[k]);
+                let shared = fvid.iter().filter(|x| g.contains(x)).count();
+                if shared == 3 {
+                    // A matching face must face the other way (AF5).
+                    if same_cycle(fvid, g) {
+                        return false;
+                    }
+                    continue;
+                }
+                let (fp, gq) = shared_first(fvid, lf.map(|k| tp[k]), g, gp);
+                if triangles_intersect(fp, gq, shared) {
+                    return false;
+                }
+            }
+        }
+        for &p in near_p {
+            if tv.contains(&p) {
+                continue;
+            }
+            let x = self.pts[p as usize];
+            if !tb.contains(x) {
+                continue;
+            }
+            if orient3d(tp[1], tp[2], tp[3], x) < 0.0
+                && orient3d(tp[0], tp[3], tp[2], x) < 0.0
+                && orient3d(tp[0], tp[1], tp[3], x) < 0.0
+                && orient3d(tp[0], tp[2], tp[1], x) < 0.0
+            {
+                return false;
+            }
+        }
+        true
+    }
+
+    /// AF3-AF5: add the tet, its new point, and update the front.
+    fn commit(&mut self, fid: u32, q: u32, pq: P3) {
+        let v = self.fv[fid as usize];
+        let q = if q >= NONE - 3 {
+            let id = self.pts.len() as u32;
+            let h = self.new_point_size(v, pq);
+            self.pts.push(pq);
+            self.hp.push(h);
+            self.pcount.push(0);
+            self.stats.new_points += 1;
+            id
+        } else {
+            q
+        };
+        let t = self.tets.len() as u32;
+        let tv = [v[0], v[1], v[2], q];
+        self.tets.push(tv);
+        self.talive.push(true);
+        self.neigh.extend_from_slice(&[NONE; 4]);
+        self.stats.tets += 1;
+        let owner = self.fowner[fid as usize];
+        self.neigh[4 * t as usize + 3] = owner;
+        if owner != NONE {
+            self.neigh[owner as usize] = 4 * t + 3;
+        }
+        self.remove_face(fid);
+        for i in 0..3 {
+            let w = TET_FACES[i].map(|k| tv[k]);
+            let fr = 4 * t + i as u32;
+            if let Some(&g) = self.fmap.get(&sorted3(w)) {
+                let o = self.fowner[g as usize];
+                self.neigh[fr as usize] = o;
+                if o != NONE {
+                    self.neigh[o as usize] = fr;
+                }
+                self.remove_face(g);
+            } else {
+                self.add_face(w, fr);
+            }
+        }
+        if self.opts.progress_every > 0 && self.stats.tets % self.opts.progress_every == 0 {
+            tracing::trace!(tets = self.stats.tets, front = self.fmap.len(), "front");
+        }
+    }
+
+    /// Drop dead tets and unused new points; input points keep their ids.
+    fn finish(self) -> FrontResult {
+        let nt = self.tets.len();
+        let mut tmap = vec![NONE; nt];
+        let mut k = 0u32;
+        for t in 0..nt {
+            if self.talive[t] {
+                tmap[t] = k;
+                k += 1;
+            }
+        }
+        let mut used = vec![false; self.pts.len()];
+        used[..self.n_input].iter_mut().for_each(|u| *u = true);
+        for t in 0..nt {
+            if self.talive[t] {
+                for &p in &self.tets[t] {
+                    used[p as usize] = true;
+                }
+            }
+        }
+        let front: Vec<[u32; 3]> = self
+            .prohibited
+            .iter()
+            .filter(|&&f| self.falive[f as usize])
+            .map(|&f| self.fv[f as usize])
+            .collect();
+        for f in &front {
+            for &p in f {
+                used[p as usize] = true;
+            }
+        }
+        let mut pmap = vec![NONE; self.pts.len()];
+        let mut points = Vec::new();
+        let mut point_size = Vec::new();
+        for (i, &u) in used.iter().enumerate() {
+            if u {
+                pmap[i] = points.len() as u32;
+                points.push(self.pts[i]);
+                point_size.push(self.hp[i]);
+            }
+        }
+        let mut tets = Vec::with_capacity(k as usize);
+        let mut neigh = Vec::with_capacity(4 * k as usize);
+        for t in 0..nt {
+            if self.talive[t] {
+                tets.push(self.tets[t].map(|p| pmap[p as usize]));
+                for i in 0..4 {
+                    let nb = self.neigh[4 * t + i];
+                    neigh.push(if nb == NONE {
+                        NONE
+                    } else {
+                        4 * tmap[(nb >> 2) as usize] + (nb & 3)
+                    });
+                }
+            }
+        }
+        let mut stats = self.stats;
+        stats.tets = tets.len();
+        stats.new_points = points.len() - self.n_input;
+        FrontResult {
+            points,
+            point_size,
+            tets,
+            neigh,
+            front: front.iter().map(|f| f.map(|p| pmap[p as usize])).collect(),
+            stats,
+        }
+    }
+}

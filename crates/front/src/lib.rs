@@ -1,0 +1,44 @@
+//! The scalar advancing front (paper §4, AF1 to AF5).
+//!
+//! One core that every later stage reuses: the serial mesher, the
+//! domain-defining grid (a size override, §5), every parallel pass (a
+//! region filter, §7), and refilling holes after smoothing (§9.3).
+//!
+//! Input is a closed front: triangles whose right-hand normals point into
+//! the region to mesh, and a size per point (AG3). Output is the tets,
+//! their `4t+f` adjacency (kept as tets are made, not rebuilt), the new
+//! points and whatever front a region filter left behind.
+
+mod core;
+pub mod grid;
+mod quality;
+
+pub use crate::core::{advance, FrontError, FrontInput, FrontOptions, FrontResult, FrontStats};
+
+use parafront_geom::P3;
+
+/// Where a pass may mesh (paper §7). The front skips faces whose points,
+/// edges or ideal point fall outside, and drops close points outside.
+pub trait RegionFilter: Sync {
+    fn point_ok(&self, _p: P3) -> bool {
+        true
+    }
+    /// The segment `a`-`b` stays inside (the paper's neighbour-to-neighbour
+    /// traversal through the DDG).
+    fn edge_ok(&self, _a: P3, _b: P3) -> bool {
+        true
+    }
+}
+
+/// No restriction: the serial mesher.
+pub struct Everywhere;
+impl RegionFilter for Everywhere {}
+
+/// How a new point gets its size (AF4).
+#[derive(Clone, Copy)]
+pub enum SizeMode<'a> {
+    /// From the size field at the new point.
+    Field(&'a (dyn Fn(P3) -> f64 + Sync)),
+    /// DDG (§5): the mean size of the removed face's points times `c`.
+    Growth(f64),
+}

@@ -1,0 +1,735 @@
+//! `check()`: every invariant of a [`TetMesh`], tested in parallel, with
+//! orientation decided by the exact predicate. `check_against_surface()`
+//! adds that the mesh boundary is exactly the input triangulation and that
+//! the tets fill the volume it encloses exactly once.
+//!
+//! All problems are collected (the first [`SAMPLES`] of each kind are kept
+//! with ids and coordinates, the rest counted), so one run shows the whole
+//! picture of a broken mesh.
+use crate::faces::*;
+use crate::ids::*;
+use crate::tetmesh::TetMesh;
+use parafront_geom::{cross, dot, orient3d, sub, tet_volume6, Aabb, P3};
+use rayon::prelude::*;
+use std::fmt;
+use std::sync::atomic::{AtomicBool, Ordering::Relaxed};
+use thiserror::Error;
+
+/// How many problems of each kind are kept with their details.
+pub const SAMPLES: usize = 5;
+
+/// Relative tolerance of the volume comparison.
+pub const VOLUME_RTOL: f64 = 1e-9;
+
+/// What a successful check measured.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct CheckStats {
+    pub n_points: usize,
+    /// Points that no tet uses.
+    pub n_unused_points: usize,
+    pub n_tets: usize,
+    /// Distinct region ids (1 when `region` is empty and there are tets).
+    pub n_regions: usize,
+    /// Faces shared by two tets of the same region.
+    pub n_interior_faces: usize,
+    /// Faces shared by two tets of different regions.
+    pub n_interface_faces: usize,
+    /// Faces of one tet only.
+    pub n_boundary_faces: usize,
+    /// Sum of tet volumes, taken absolute so inverted tets cannot cancel
+    /// against others: it equals the enclosed volume only when the tets
+    /// cover the domain exactly once.
+    pub volume: f64,
+    /// Smallest tet volume (floating point; the sign test is exact).
+    pub min_volume: f64,
+    /// Volume enclosed by the input triangles (`check_against_surface` only).
+    pub surface_volume: Option<f64>,
+}
+
+/// The kinds of [`MeshProblem`], for counting and matching.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum ProblemKind {
+    ArrayLength,
+    NonFinitePoint,
+    PointOutOfRange,
+    RepeatedVertex,
+    NotPositive,
+    FaceInManyTets,
+    FaceSameSide,
+    NeighWrong,
+    BadInputTriangle,
+    MissingBoundaryFace,
+    ExtraBoundaryFace,
+    FlippedBoundaryFace,
+    DuplicateInputTriangle,
+    VolumeMismatch,
+}
+const NK: usize = ProblemKind::VolumeMismatch as usize + 1;
+
+struct Pt(P3);
+impl fmt::Display for Pt {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "({}, {}, {})", self.0[0], self.0[1], self.0[2])
+    }
+}
+struct Pts<'a>(&'a [P3]);
+impl fmt::Display for Pts<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        for (i, p) in self.0.iter().enumerate() {
+            if i > 0 {
+                write!(f, " ")?;
+            }
+            write!(f, "{}", Pt(*p))?;
+        }
+        Ok(())
+    }
+}
+fn ids<T: fmt::Display>(v: &[T]) -> String {
+    v.iter()
+        .map(|x| x.to_string())
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// One thing wrong with a mesh, with the ids and coordinates involved.
+#[derive(Clone, Debug, PartialEq, Error)]
+pub enum MeshProblem {
+    #[error("array {name} has length {len}, expected {expected}")]
+    ArrayLength {
+        name: &'static str,
+        len: usize,
+        expected: String,
+    },
+    #[error("point {point} has a non-finite coordinate {}", Pt(*coords))]
+    NonFinitePoint { point: PointId, coords: P3 },
+    #[error("tet {tet} uses point {point}, but there are only {n_points} points")]
+    PointOutOfRange {
+        tet: TetId,
+        point: PointId,
+        n_points: usize,
+    },
+    #[error("tet {tet} repeats a vertex: ({})", ids(verts))]
+    RepeatedVertex { tet: TetId, verts: [PointId; 4] },
+    #[error(
+        "tet {tet} ({}) is {} (6*volume = {volume6:e}): {}",
+        ids(verts), if *flat { "flat" } else { "inverted" }, Pts(coords)
+    )]
+    NotPositive {
+        tet: TetId,
+        verts: [PointId; 4],
+        coords: [P3; 4],
+        /// Floating-point six times volume (the sign decision is exact).
+        volume6: f64,
+        /// Zero volume exactly, rather than negative.
+        flat: bool,
+    },
+    #[error("face ({}) belongs to {} tets: {}", ids(face), tets.len(), ids(tets))]
+    FaceInManyTets {
+        face: [PointId; 3],
+        tets: Vec<TetId>,
+    },
+    #[error(
+        "tets {} and {} both see face ({}) from the same side (overlap or inversion)",
+        tets[0], tets[1], ids(face)
+    )]
+    FaceSameSide {
+        face: [PointId; 3],
+        tets: [TetId; 2],
+    },
+    #[error(
+        "neigh of face {} of tet {} ({}) is {}, expected {}",
+        face.local(), face.tet(), ids(verts), fref(*found), fref(*expected)
+    )]
+    NeighWrong {
+        face: FaceRef,
+        verts: [PointId; 3],
+        found: FaceRef,
+        expected: FaceRef,
+    },
+    #[error("input triangle {tri} ({}) {why}", ids(verts))]
+    BadInputTriangle {
+        tri: usize,
+        verts: [u32; 3],
+        why: &'static str,
+    },
+    #[error(
+        "input triangle {tri} ({}) is not a mesh boundary face: {why}; at {}",
+        ids(verts),
+        Pts(coords)
+    )]
+    MissingBoundaryFace {
+        tri: usize,
+        verts: [u32; 3],
+        coords: [P3; 3],
+        why: String,
+    },
+    #[error(
+        "face {} of tet {} ({}) is {} but no input triangle; at {}",
+        face.local(), face.tet(), ids(verts),
+        match regions { Some(r) => format!("an interface between regions {} and {}", r[0], r[1]), None => "on the boundary".into() },
+        Pts(coords)
+    )]
+    ExtraBoundaryFace {
+        face: FaceRef,
+        verts: [PointId; 3],
+        coords: [P3; 3],
+        /// The two regions when the face lies between two tets.
+        regions: Option<[u32; 2]>,
+    },
+    #[error(
+        "input triangle {tri} ({}) is reversed: the mesh boundary face {} of tet {} is ({})",
+        ids(verts), face.local(), face.tet(), ids(mesh_verts)
+    )]
+    FlippedBoundaryFace {
+        tri: usize,
+        verts: [u32; 3],
+        face: FaceRef,
+        mesh_verts: [PointId; 3],
+    },
+    #[error(
+        "input triangles {} are the same face ({}) one time too many",
+        ids(tris),
+        ids(verts)
+    )]
+    DuplicateInputTriangle { tris: Vec<usize>, verts: [u32; 3] },
+    #[error(
+        "tet volumes sum to {mesh}, but the triangles enclose {surface} (relative difference {rel:e})"
+    )]
+    VolumeMismatch { mesh: f64, surface: f64, rel: f64 },
+}
+
+fn fref(f: FaceRef) -> String {
+    if f.is_none() {
+        "none (boundary)".into()
+    } else {
+        format!("face {} of tet {}", f.local(), f.tet())
+    }
+}
+
+impl MeshProblem {
+    pub fn kind(&self) -> ProblemKind {
+        use MeshProblem as P;
+        use ProblemKind as K;
+        match self {
+            P::ArrayLength { .. } => K::ArrayLength,
+            P::NonFinitePoint { .. } => K::NonFinitePoint,
+            P::PointOutOfRange { .. } => K::PointOutOfRange,
+            P::RepeatedVertex { .. } => K::RepeatedVertex,
+            P::NotPositive { .. } => K::NotPositive,
+            P::FaceInManyTets { .. } => K::FaceInManyTets,
+            P::FaceSameSide { .. } => K::FaceSameSide,
+            P::NeighWrong { .. } => K::NeighWrong,
+            P::BadInputTriangle { .. } => K::BadInputTriangle,
+            P::MissingBoundaryFace { .. } => K::MissingBoundaryFace,
+            P::ExtraBoundaryFace { .. } => K::ExtraBoundaryFace,
+            P::FlippedBoundaryFace { .. } => K::FlippedBoundaryFace,
+            P::DuplicateInputTriangle { .. } => K::DuplicateInputTriangle,
+            P::VolumeMismatch { .. } => K::VolumeMismatch,
+        }
+    }
+}
+
+/// A mesh that failed its check: the first few problems of each kind, and
+/// how many of each kind there were.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CheckError {
+    /// Up to [`SAMPLES`] problems of each kind, in element order per kind.
+    pub problems: Vec<MeshProblem>,
+    /// Number of problems found, per kind, for kinds that occurred.
+    pub counts: Vec<(ProblemKind, usize)>,
+}
+
+impl CheckError {
+    /// How many problems of kind `k` were found.
+    pub fn count(&self, k: ProblemKind) -> usize {
+        self.counts
+            .iter()
+            .find(|c| c.0 == k)
+            .map(|c| c.1)
+            .unwrap_or(0)
+    }
+    /// The kept problems of kind `k`.
+    pub fn of_kind(&self, k: ProblemKind) -> impl Iterator<Item = &MeshProblem> {
+        self.problems.iter().filter(move |p| p.kind() == k)
+    }
+}
+
+impl fmt::Display for CheckError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let total: usize = self.counts.iter().map(|c| c.1).sum();
+        write!(f, "mesh check failed with {total} problems (")?;
+        for (i, (k, n)) in self.counts.iter().enumerate() {
+            write!(f, "{}{n} {k:?}", if i > 0 { ", " } else { "" })?;
+        }
+        write!(f, ")")?;
+        for p in &self.problems {
+            write!(f, "\n  - {p}")?;
+        }
+        Ok(())
+    }
+}
+impl std::error::Error for CheckError {}
+
+/// Problems found by one piece of parallel work; merging keeps the first
+/// `SAMPLES` of each kind in order.
+#[derive(Default)]
+struct Found {
+    counts: [usize; NK],
+    kept: [usize; NK],
+    samples: Vec<MeshProblem>,
+}
+impl Found {
+    fn push(&mut self, p: MeshProblem) {
+        let k = p.kind() as usize;
+        self.counts[k] += 1;
+        if self.kept[k] < SAMPLES {
+            self.kept[k] += 1;
+            self.samples.push(p);
+        }
+    }
+    fn merge(mut self, o: Found) -> Found {
+        for p in o.samples {
+            let k = p.kind() as usize;
+            if self.kept[k] < SAMPLES {
+                self.kept[k] += 1;
+                self.samples.push(p);
+            }
+        }
+        for k in 0..NK {
+            self.counts[k] += o.counts[k];
+        }
+        self
+    }
+    fn is_empty(&self) -> bool {
+        self.counts.iter().all(|&c| c == 0)
+    }
+    fn into_error(mut self) -> CheckError {
+        self.samples.sort_by_key(|p| p.kind());
+        let kinds = [
+            ProblemKind::ArrayLength,
+            ProblemKind::NonFinitePoint,
+            ProblemKind::PointOutOfRange,
+            ProblemKind::RepeatedVertex,
+            ProblemKind::NotPositive,
+            ProblemKind::FaceInManyTets,
+            ProblemKind::FaceSameSide,
+            ProblemKind::NeighWrong,
+            ProblemKind::BadInputTriangle,
+            ProblemKind::MissingBoundaryFace,
+            ProblemKind::ExtraBoundaryFace,
+            ProblemKind::FlippedBoundaryFace,
+            ProblemKind::DuplicateInputTriangle,
+            ProblemKind::VolumeMismatch,
+        ];
+        CheckError {
+            problems: self.samples,
+            counts: kinds
+                .into_iter()
+                .filter(|&k| self.counts[k as usize] > 0)
+                .map(|k| (k, self.counts[k as usize]))
+                .collect(),
+        }
+    }
+}
+
+/// Per-chunk result of the tet pass.
+struct TetAcc {
+    found: Found,
+    vol6: f64,
+    min_vol6: f64,
+}
+
+/// Per-chunk result of the face pass.
+#[derive(Default)]
+struct FaceAcc {
+    found: Found,
+    interior: usize,
+    interface: usize,
+    boundary: usize,
+}
+
+impl TetMesh {
+    /// Checks every invariant: point ids in range, no repeated vertex in a
+    /// tet, every tet positive under the exact predicate, every face in at
+    /// most two tets and seen from opposite sides, finite coordinates, and
+    /// (when built) `neigh` symmetric and matching the faces.
+    pub fn check(&self) -> Result<CheckStats, CheckError> {
+        self.check_impl(None)
+    }
+
+    /// [`check`](Self::check), plus: the mesh boundary faces, and the faces
+    /// between tets of different regions, are exactly the triangles `tris`
+    /// (point ids into `self.points`; boundary faces in the same
+    /// orientation, interface faces in either), and the tet volumes add up
+    /// to the volume the triangles enclose.
+    pub fn check_against_surface(&self, tris: &[[u32; 3]]) -> Result<CheckStats, CheckError> {
+        self.check_impl(Some(tris))
+    }
+
+    fn check_impl(&self, tris: Option<&[[u32; 3]]>) -> Result<CheckStats, CheckError> {
+        let np = self.points.len();
+        let nt = self.tets.len();
+        let mut found = Found::default();
+        if nt > crate::adjacency::MAX_TETS {
+            found.push(MeshProblem::ArrayLength {
+                name: "tets",
+                len: nt,
+                expected: format!("at most {}", crate::adjacency::MAX_TETS),
+            });
+            return Err(found.into_error());
+        }
+        let neigh_ok = match self.neigh.len() {
+            0 => false,
+            l if l == 4 * nt => true,
+            l => {
+                found.push(MeshProblem::ArrayLength {
+                    name: "neigh",
+                    len: l,
+                    expected: format!("0 or 4 * {nt} tets = {}", 4 * nt),
+                });
+                false
+            }
+        };
+        let region_ok = self.region.is_empty() || self.region.len() == nt;
+        if !region_ok {
+            found.push(MeshProblem::ArrayLength {
+                name: "region",
+                len: self.region.len(),
+                expected: format!("0 or {nt} (one per tet)"),
+            });
+        }
+        let region = |t: TetId| -> u32 {
+            if region_ok {
+                self.region_of(t)
+            } else {
+                0
+            }
+        };
+
+        // Points.
+        let pf = self
+            .points
+            .par_iter()
+            .enumerate()
+            .fold(Found::default, |mut acc, (i, p)| {
+                if !p.iter().all(|x| x.is_finite()) {
+                    acc.push(MeshProblem::NonFinitePoint {
+                        point: PointId::new(i),
+                        coords: *p,
+                    });
+                }
+                acc
+            })
+            .reduce(Found::default, Found::merge);
+        let finite_ok = pf.is_empty();
+        found = found.merge(pf);
+
+        // Tets: ids, repeats, exact orientation, volume.
+        let used: Vec<AtomicBool> = (0..np)
+            .into_par_iter()
+            .map(|_| AtomicBool::new(false))
+            .collect();
+        let ta = self
+            .tets
+            .par_iter()
+            .enumerate()
+            .fold(
+                || TetAcc {
+                    found: Found::default(),
+                    vol6: 0.0,
+                    min_vol6: f64::INFINITY,
+                },
+                |mut acc, (t, tet)| {
+                    let tid = TetId::new(t);
+                    let mut in_range = true;
+                    for &p in tet {
+                        if p.idx() < np {
+                            used[p.idx()].store(true, Relaxed);
+                        } else {
+                            in_range = false;
+                            acc.found.push(MeshProblem::PointOutOfRange {
+                                tet: tid,
+                                point: p,
+                                n_points: np,
+                            });
+                        }
+                    }
+                    if has_repeat(tet) {
+                        acc.found.push(MeshProblem::RepeatedVertex {
+                            tet: tid,
+                            verts: *tet,
+                        });
+                    } else if in_range {
+                        let c = self.tet_points(tid);
+                        let v6 = tet_volume6(c[0], c[1], c[2], c[3]);
+                        acc.vol6 += v6.abs();
+                        acc.min_vol6 = acc.min_vol6.min(v6);
+                        if finite_ok && orient3d(c[0], c[1], c[2], c[3]) <= 0.0 {
+                            acc.found.push(MeshProblem::NotPositive {
+                                tet: tid,
+                                verts: *tet,
+                                coords: c,
+                                volume6: v6,
+                                flat: orient3d(c[0], c[1], c[2], c[3]) == 0.0,
+                            });
+                        }
+                    }
+                    acc
+                },
+            )
+            .reduce(
+                || TetAcc {
+                    found: Found::default(),
+                    vol6: 0.0,
+                    min_vol6: f64::INFINITY,
+                },
+                |a, b| TetAcc {
+                    found: a.found.merge(b.found),
+                    vol6: a.vol6 + b.vol6,
+                    min_vol6: a.min_vol6.min(b.min_vol6),
+                },
+            );
+        found = found.merge(ta.found);
+        let n_unused_points = used.par_iter().filter(|u| !u.load(Relaxed)).count();
+        drop(used);
+
+        // The input triangles, validated, as sorted keys (low = index).
+        let in_keys: Vec<u128> = match tris {
+            None => Vec::new(),
+            Some(tris) => {
+                let (f, mut keys) = tris
+                    .par_iter()
+                    .enumerate()
+                    .fold(
+                        || (Found::default(), Vec::new()),
+                        |(mut f, mut keys), (i, t)| {
+                            if let Some(&p) = t.iter().find(|&&p| p as usize >= np) {
+                                f.push(MeshProblem::BadInputTriangle {
+                                    tri: i,
+                                    verts: *t,
+                                    why: if p == u32::MAX {
+                                        "uses point id u32::MAX"
+                                    } else {
+                                        "uses a point id past the end of the points"
+                                    },
+                                });
+                            } else if t[0] == t[1] || t[1] == t[2] || t[0] == t[2] {
+                                f.push(MeshProblem::BadInputTriangle {
+                                    tri: i,
+                                    verts: *t,
+                                    why: "repeats a vertex",
+                                });
+                            } else {
+                                keys.push(pack(sort3(*t).0, i as u32));
+                            }
+                            (f, keys)
+                        },
+                    )
+                    .reduce(
+                        || (Found::default(), Vec::new()),
+                        |(fa, mut ka), (fb, kb)| {
+                            ka.extend(kb);
+                            (fa.merge(fb), ka)
+                        },
+                    );
+                found = found.merge(f);
+                keys.par_sort_unstable();
+                keys
+            }
+        };
+        let in_parity = |k: u128| sort3(tris.unwrap()[low(k) as usize]).1;
+
+        // Faces: pairing, neigh, and the mesh side of the surface match.
+        let keys = face_keys(&self.tets);
+        let tets = &self.tets;
+        let pt = |p: PointId| self.points.get(p.idx()).copied().unwrap_or([f64::NAN; 3]);
+        let fa = group_chunks(&keys)
+            .par_iter()
+            .map(|chunk| {
+                let mut acc = FaceAcc::default();
+                for_each_group(chunk, |g| {
+                    let face = unpack_triple(g[0]).map(PointId);
+                    let expect = |acc: &mut FaceAcc, f: u32, e: FaceRef| {
+                        if neigh_ok && self.neigh[f as usize] != e {
+                            acc.found.push(MeshProblem::NeighWrong {
+                                face: FaceRef(f),
+                                verts: self.face_points(FaceRef(f)),
+                                found: self.neigh[f as usize],
+                                expected: e,
+                            });
+                        }
+                    };
+                    let mut regions = None;
+                    match g.len() {
+                        1 => {
+                            acc.boundary += 1;
+                            expect(&mut acc, low(g[0]), NO_FACE);
+                        }
+                        2 => {
+                            let (a, b) = (low(g[0]), low(g[1]));
+                            if face_parity(tets, a) == face_parity(tets, b) {
+                                acc.found.push(MeshProblem::FaceSameSide {
+                                    face,
+                                    tets: [FaceRef(a).tet(), FaceRef(b).tet()],
+                                });
+                                return;
+                            }
+                            expect(&mut acc, a, FaceRef(b));
+                            expect(&mut acc, b, FaceRef(a));
+                            let (ra, rb) = (region(FaceRef(a).tet()), region(FaceRef(b).tet()));
+                            if ra == rb {
+                                acc.interior += 1;
+                                return;
+                            }
+                            acc.interface += 1;
+                            regions = Some([ra, rb]);
+                        }
+                        _ => {
+                            acc.found.push(MeshProblem::FaceInManyTets {
+                                face,
+                                tets: g.iter().map(|&k| FaceRef(low(k)).tet()).collect(),
+                            });
+                            return;
+                        }
+                    }
+                    if tris.is_none() {
+                        return;
+                    }
+                    // A boundary or interface face: it must be an input triangle.
+                    let fr = FaceRef(low(g[0]));
+                    let r = find_triple(&in_keys, unpack_triple(g[0]));
+                    let tv = unpack_triple(g[0]);
+                    if r.is_empty() {
+                        let verts = self.face_points(fr);
+                        acc.found.push(MeshProblem::ExtraBoundaryFace {
+                            face: fr,
+                            verts,
+                            coords: verts.map(pt),
+                            regions,
+                        });
+                    } else if regions.is_none() {
+                        let p = face_parity(tets, fr.0);
+                        if r.len() > 1 {
+                            acc.found.push(MeshProblem::DuplicateInputTriangle {
+                                tris: r.iter().map(|&k| low(k) as usize).collect(),
+                                verts: tv,
+                            });
+                        } else if in_parity(r[0]) != p {
+                            acc.found.push(MeshProblem::FlippedBoundaryFace {
+                                tri: low(r[0]) as usize,
+                                verts: tris.unwrap()[low(r[0]) as usize],
+                                face: fr,
+                                mesh_verts: self.face_points(fr),
+                            });
+                        }
+                    } else if r.len() > 2 || (r.len() == 2 && in_parity(r[0]) == in_parity(r[1])) {
+                        acc.found.push(MeshProblem::DuplicateInputTriangle {
+                            tris: r.iter().map(|&k| low(k) as usize).collect(),
+                            verts: tv,
+                        });
+                    }
+                });
+                acc
+            })
+            .reduce(FaceAcc::default, |a, b| FaceAcc {
+                found: a.found.merge(b.found),
+                interior: a.interior + b.interior,
+                interface: a.interface + b.interface,
+                boundary: a.boundary + b.boundary,
+            });
+        found = found.merge(fa.found);
+
+        // The input side: triangles that are no boundary face, and the
+        // enclosed volume (interface triangles enclose nothing).
+        let mut surface_volume = None;
+        if let Some(tris) = tris {
+            let c = Aabb::from_points(&self.points).center();
+            let (f, flux, flux_abs) = group_chunks(&in_keys)
+                .par_iter()
+                .map(|chunk| {
+                    let mut f = Found::default();
+                    let (mut flux, mut flux_abs) = (0.0, 0.0);
+                    for_each_group(chunk, |g| {
+                        let m = find_triple(&keys, unpack_triple(g[0]));
+                        let interface = m.len() == 2
+                            && region(FaceRef(low(m[0])).tet()) != region(FaceRef(low(m[1])).tet());
+                        let why = match m.len() {
+                            0 => Some("no tet has this face".to_string()),
+                            2 if !interface
+                                && face_parity(tets, low(m[0])) != face_parity(tets, low(m[1])) =>
+                            {
+                                let (a, b) = (FaceRef(low(m[0])).tet(), FaceRef(low(m[1])).tet());
+                                Some(format!(
+                                    "it lies inside region {}, between tets {a} and {b}",
+                                    region(a)
+                                ))
+                            }
+                            _ => None,
+                        };
+                        for &k in g {
+                            let t = tris[low(k) as usize];
+                            if let Some(why) = &why {
+                                f.push(MeshProblem::MissingBoundaryFace {
+                                    tri: low(k) as usize,
+                                    verts: t,
+                                    coords: t.map(|p| self.points[p as usize]),
+                                    why: why.clone(),
+                                });
+                            }
+                            if !interface {
+                                let [a, b, d] = t.map(|p| sub(self.points[p as usize], c));
+                                let v = dot(a, cross(b, d));
+                                flux += v;
+                                flux_abs += v.abs();
+                            }
+                        }
+                    });
+                    (f, flux, flux_abs)
+                })
+                .reduce(
+                    || (Found::default(), 0.0, 0.0),
+                    |a, b| (a.0.merge(b.0), a.1 + b.1, a.2 + b.2),
+                );
+            found = found.merge(f);
+            let (vm, vs) = (ta.vol6 / 6.0, flux / 6.0);
+            // Rounding bound of both sums, or the relative tolerance.
+            let tol = (VOLUME_RTOL * vm.abs().max(vs.abs()))
+                .max(64.0 * f64::EPSILON * (ta.vol6 + flux_abs) / 6.0);
+            let diff = (vm - vs).abs();
+            if diff > tol || diff.is_nan() {
+                found.push(MeshProblem::VolumeMismatch {
+                    mesh: vm,
+                    surface: vs,
+                    rel: (vm - vs).abs() / vm.abs().max(vs.abs()),
+                });
+            }
+            surface_volume = Some(vs);
+        }
+
+        if !found.is_empty() {
+            return Err(found.into_error());
+        }
+        let n_regions = if nt == 0 {
+            0
+        } else if self.region.is_empty() {
+            1
+        } else {
+            let mut r = self.region.clone();
+            r.par_sort_unstable();
+            r.dedup();
+            r.len()
+        };
+        Ok(CheckStats {
+            n_points: np,
+            n_unused_points,
+            n_tets: nt,
+            n_regions,
+            n_interior_faces: fa.interior,
+            n_interface_faces: fa.interface,
+            n_boundary_faces: fa.boundary,
+            volume: ta.vol6 / 6.0,
+            min_volume: if nt == 0 { 0.0 } else { ta.min_vol6 / 6.0 },
+            surface_volume,
+        })
+    }
+}

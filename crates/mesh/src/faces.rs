@@ -1,0 +1,182 @@
+//! The face table: every tet face as a `u128` key (sorted vertex triple in
+//! the high 96 bits, its `FaceRef` in the low 32), sorted so that the faces
+//! with the same three vertices lie next to each other. Adjacency building
+//! and `check()` both pair faces through it; it needs no coordinates.
+use crate::ids::*;
+use crate::tetmesh::TET_FACES;
+use rayon::prelude::*;
+
+/// The three vertex ids sorted ascending, and whether sorting took an odd
+/// permutation. Two faces with the same triple are seen from opposite sides
+/// exactly when their parities differ.
+#[inline(always)]
+pub(crate) fn sort3(v: [u32; 3]) -> ([u32; 3], bool) {
+    let [mut a, mut b, mut c] = v;
+    let mut odd = false;
+    if a > b {
+        std::mem::swap(&mut a, &mut b);
+        odd = !odd;
+    }
+    if b > c {
+        std::mem::swap(&mut b, &mut c);
+        odd = !odd;
+    }
+    if a > b {
+        std::mem::swap(&mut a, &mut b);
+        odd = !odd;
+    }
+    ([a, b, c], odd)
+}
+
+#[inline(always)]
+pub(crate) fn pack(t: [u32; 3], low: u32) -> u128 {
+    ((t[0] as u128) << 96) | ((t[1] as u128) << 64) | ((t[2] as u128) << 32) | low as u128
+}
+
+/// The triple part of a key (the low 32 bits cleared).
+#[inline(always)]
+pub(crate) fn triple_bits(k: u128) -> u128 {
+    k >> 32
+}
+
+#[inline(always)]
+pub(crate) fn unpack_triple(k: u128) -> [u32; 3] {
+    [(k >> 96) as u32, (k >> 64) as u32, (k >> 32) as u32]
+}
+
+#[inline(always)]
+pub(crate) fn low(k: u128) -> u32 {
+    k as u32
+}
+
+/// Vertex ids of face `f` of tet `t`, outward from `t`.
+#[inline(always)]
+pub(crate) fn face_verts(tet: &[PointId; 4], f: usize) -> [u32; 3] {
+    let l = TET_FACES[f];
+    [tet[l[0]].0, tet[l[1]].0, tet[l[2]].0]
+}
+
+/// True when the tet lists the same point twice; such a tet has no proper
+/// faces and is left out of the face table.
+#[inline(always)]
+pub(crate) fn has_repeat(t: &[PointId; 4]) -> bool {
+    t[0] == t[1] || t[0] == t[2] || t[0] == t[3] || t[1] == t[2] || t[1] == t[3] || t[2] == t[3]
+}
+
+/// Sorted face keys of all tets without repeated vertices.
+pub(crate) fn face_keys(tets: &[[PointId; 4]]) -> Vec<u128> {
+    // Filled in place (indexed, no intermediate lists); a repeating tet's
+    // slots get the largest key, which no face can have (its low 32 bits
+    // would be NO_FACE), and are cut off after sorting.
+    let mut keys = vec![0u128; 4 * tets.len()];
+    keys.par_chunks_mut(4)
+        .zip(tets.par_iter())
+        .enumerate()
+        .for_each(|(t, (k, tet))| {
+            let skip = has_repeat(tet);
+            for f in 0..4 {
+                k[f] = if skip {
+                    u128::MAX
+                } else {
+                    pack(sort3(face_verts(tet, f)).0, (4 * t + f) as u32)
+                };
+            }
+        });
+    keys.par_sort_unstable();
+    let n = keys.partition_point(|&k| k != u128::MAX);
+    keys.truncate(n);
+    keys
+}
+
+/// Splits a sorted key array into about `8 * threads` chunks that start at
+/// group boundaries (a group = the keys sharing one triple), so each chunk
+/// can walk its groups alone.
+pub(crate) fn group_chunks(keys: &[u128]) -> Vec<&[u128]> {
+    let n = keys.len();
+    if n == 0 {
+        return Vec::new();
+    }
+    let parts = (rayon::current_num_threads() * 8).clamp(1, n);
+    let mut cuts = Vec::with_capacity(parts + 1);
+    cuts.push(0);
+    for p in 1..parts {
+        let mut c = (p * n / parts).max(*cuts.last().unwrap());
+        while c > 0 && c < n && triple_bits(keys[c]) == triple_bits(keys[c - 1]) {
+            c += 1;
+        }
+        if c < n && c > *cuts.last().unwrap() {
+            cuts.push(c);
+        }
+    }
+    cuts.push(n);
+    cuts.windows(2).map(|w| &keys[w[0]..w[1]]).collect()
+}
+
+/// Calls `f` on each group (run of keys with equal triples) of a chunk.
+#[inline]
+pub(crate) fn for_each_group(chunk: &[u128], mut f: impl FnMut(&[u128])) {
+    let mut s = 0;
+    while s < chunk.len() {
+        let tb = triple_bits(chunk[s]);
+        let mut e = s + 1;
+        while e < chunk.len() && triple_bits(chunk[e]) == tb {
+            e += 1;
+        }
+        f(&chunk[s..e]);
+        s = e;
+    }
+}
+
+/// The range of keys in `keys` (sorted) whose triple equals `t`.
+#[inline]
+pub(crate) fn find_triple(keys: &[u128], t: [u32; 3]) -> &[u128] {
+    let lo = pack(t, 0);
+    let tb = triple_bits(lo);
+    let s = keys.partition_point(|&k| k < lo);
+    let e = s + keys[s..].partition_point(|&k| triple_bits(k) == tb);
+    &keys[s..e]
+}
+
+/// Parity of face `fr` as listed (outward from its tet).
+#[inline(always)]
+pub(crate) fn face_parity(tets: &[[PointId; 4]], fr: u32) -> bool {
+    let fr = FaceRef(fr);
+    sort3(face_verts(&tets[fr.tet().idx()], fr.local())).1
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sort3_parity() {
+        assert_eq!(sort3([1, 2, 3]), ([1, 2, 3], false));
+        assert_eq!(sort3([2, 3, 1]), ([1, 2, 3], false));
+        assert_eq!(sort3([3, 1, 2]), ([1, 2, 3], false));
+        assert_eq!(sort3([1, 3, 2]), ([1, 2, 3], true));
+        assert_eq!(sort3([3, 2, 1]), ([1, 2, 3], true));
+        assert_eq!(sort3([2, 1, 3]), ([1, 2, 3], true));
+    }
+
+    #[test]
+    fn chunks_do_not_split_groups() {
+        let mut keys = Vec::new();
+        for i in 0..1000u32 {
+            for j in 0..(i % 3 + 1) {
+                keys.push(pack([i, i + 1, i + 2], j));
+            }
+        }
+        let chunks = group_chunks(&keys);
+        assert_eq!(chunks.iter().map(|c| c.len()).sum::<usize>(), keys.len());
+        let mut groups = 0;
+        for c in &chunks {
+            for_each_group(c, |g| {
+                assert_eq!(g.len() as u32, unpack_triple(g[0])[0] % 3 + 1);
+                groups += 1;
+            });
+        }
+        assert_eq!(groups, 1000);
+        assert_eq!(find_triple(&keys, [5, 6, 7]).len(), 3);
+        assert_eq!(find_triple(&keys, [5, 6, 8]).len(), 0);
+    }
+}

@@ -1,0 +1,493 @@
+//! Element quality: dihedral angles, radius ratio, mean ratio, and edge
+//! length against a target size, per tet and as a [`QualityReport`] with
+//! histograms. All measures are similarity invariant; the ratios are 1 for
+//! the regular tet and go to 0 for flat ones (negative when inverted).
+use crate::ids::*;
+use crate::tetmesh::{TetMesh, TET_FACES};
+use parafront_geom::{cross, dist, dist2, dot, norm, norm2, scale, sub, tet_volume6, P3};
+use rayon::prelude::*;
+use std::fmt;
+
+/// The six edges of a tet as local vertex pairs.
+pub const TET_EDGES: [[usize; 2]; 6] = [[0, 1], [0, 2], [0, 3], [1, 2], [1, 3], [2, 3]];
+
+/// Dihedral angle of the regular tet, degrees (`acos(1/3)`).
+pub const REGULAR_DIHEDRAL: f64 = 70.528_779_365_509_31;
+
+/// Quality of one tet.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TetQuality {
+    /// Smallest and largest dihedral angle, degrees.
+    pub min_dihedral: f64,
+    pub max_dihedral: f64,
+    /// `3 r / R` (inradius over circumradius); 1 regular, < 0 inverted.
+    pub radius_ratio: f64,
+    /// `12 (3V)^(2/3) / sum l^2`; 1 regular, < 0 inverted.
+    pub mean_ratio: f64,
+    /// Signed volume (floating point).
+    pub volume: f64,
+}
+
+/// Dihedral angles in degrees at the edges [`TET_EDGES`]. The angle at
+/// edge (i, j) is between the faces opposite the other two vertices.
+pub fn dihedral_angles(p: [P3; 4]) -> [f64; 6] {
+    let n = TET_FACES.map(|f| {
+        let (a, b, c) = (p[f[0]], p[f[1]], p[f[2]]);
+        cross(sub(b, a), sub(c, a))
+    });
+    TET_EDGES.map(|[i, j]| {
+        let mut o = (0..4).filter(|&k| k != i && k != j);
+        let (k, l) = (o.next().unwrap(), o.next().unwrap());
+        // Outward normals: the interior angle is pi minus their angle.
+        norm(cross(n[k], n[l])).atan2(-dot(n[k], n[l])).to_degrees()
+    })
+}
+
+/// `3 r / R`, signed by the volume; 0 for a flat tet.
+pub fn radius_ratio(p: [P3; 4]) -> f64 {
+    let (u, v, w) = (sub(p[1], p[0]), sub(p[2], p[0]), sub(p[3], p[0]));
+    let v6 = dot(u, cross(v, w));
+    // Circumcentre offset from p[0] is num / (2 v6); r = 3V / area.
+    let num = [
+        scale(cross(v, w), norm2(u)),
+        scale(cross(w, u), norm2(v)),
+        scale(cross(u, v), norm2(w)),
+    ];
+    let num = norm([
+        num[0][0] + num[1][0] + num[2][0],
+        num[0][1] + num[1][1] + num[2][1],
+        num[0][2] + num[1][2] + num[2][2],
+    ]);
+    let area: f64 = TET_FACES
+        .iter()
+        .map(|f| 0.5 * norm(cross(sub(p[f[1]], p[f[0]]), sub(p[f[2]], p[f[0]]))))
+        .sum();
+    let den = area * num;
+    if den > 0.0 && den.is_finite() {
+        3.0 * v6 * v6.abs() / den
+    } else {
+        0.0
+    }
+}
+
+/// `12 (3|V|)^(2/3) / sum l^2`, signed by the volume.
+pub fn mean_ratio(p: [P3; 4]) -> f64 {
+    let v6 = tet_volume6(p[0], p[1], p[2], p[3]);
+    let l2: f64 = TET_EDGES.iter().map(|e| dist2(p[e[0]], p[e[1]])).sum();
+    if l2 > 0.0 {
+        (12.0 * (0.5 * v6.abs()).powf(2.0 / 3.0) / l2).copysign(v6)
+    } else {
+        0.0
+    }
+}
+
+pub fn tet_quality(p: [P3; 4]) -> TetQuality {
+    let d = dihedral_angles(p);
+    TetQuality {
+        min_dihedral: d.iter().copied().fold(f64::INFINITY, f64::min),
+        max_dihedral: d.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+        radius_ratio: radius_ratio(p),
+        mean_ratio: mean_ratio(p),
+        volume: tet_volume6(p[0], p[1], p[2], p[3]) / 6.0,
+    }
+}
+
+/// Quality of every tet; `None` for a tet with a point id out of range.
+pub fn tet_qualities(mesh: &TetMesh) -> Vec<Option<TetQuality>> {
+    mesh.tets
+        .par_iter()
+        .map(|t| tet_coords(mesh, t).map(tet_quality))
+        .collect()
+}
+
+fn tet_coords(mesh: &TetMesh, t: &[PointId; 4]) -> Option<[P3; 4]> {
+    let mut c = [[0.0; 3]; 4];
+    for k in 0..4 {
+        c[k] = *mesh.points.get(t[k].idx())?;
+    }
+    Some(c)
+}
+
+/// Edge length over the target size at the edge midpoint, once per edge.
+/// Edges with an out-of-range point, or where `size` is not positive, are
+/// left out.
+pub fn edge_size_ratios(mesh: &TetMesh, size: impl Fn(P3) -> f64 + Sync) -> Vec<f64> {
+    let np = mesh.points.len();
+    // Six slots per tet; edges with a bad id get u64::MAX, cut after sorting.
+    let mut edges = vec![0u64; 6 * mesh.tets.len()];
+    edges
+        .par_chunks_mut(6)
+        .zip(mesh.tets.par_iter())
+        .for_each(|(k, t)| {
+            for (slot, e) in k.iter_mut().zip(TET_EDGES) {
+                let (a, b) = (t[e[0]].0.min(t[e[1]].0), t[e[0]].0.max(t[e[1]].0));
+                *slot = if a != b && (b as usize) < np {
+                    ((a as u64) << 32) | b as u64
+                } else {
+                    u64::MAX
+                };
+            }
+        });
+    edges.par_sort_unstable();
+    edges.truncate(edges.partition_point(|&e| e != u64::MAX));
+    edges.dedup();
+    edges
+        .par_iter()
+        .filter_map(|&e| {
+            let (a, b) = (
+                mesh.points[(e >> 32) as usize],
+                mesh.points[e as u32 as usize],
+            );
+            let h = size(scale(parafront_geom::add(a, b), 0.5));
+            (h > 0.0).then(|| dist(a, b) / h)
+        })
+        .collect()
+}
+
+/// Min, mean and max of a measure.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Stat {
+    pub min: f64,
+    pub mean: f64,
+    pub max: f64,
+    pub count: usize,
+}
+
+#[derive(Clone, Copy)]
+struct StatAcc {
+    min: f64,
+    max: f64,
+    sum: f64,
+    n: usize,
+}
+impl StatAcc {
+    const EMPTY: StatAcc = StatAcc {
+        min: f64::INFINITY,
+        max: f64::NEG_INFINITY,
+        sum: 0.0,
+        n: 0,
+    };
+    fn add(&mut self, x: f64) {
+        self.min = self.min.min(x);
+        self.max = self.max.max(x);
+        self.sum += x;
+        self.n += 1;
+    }
+    fn merge(self, o: StatAcc) -> StatAcc {
+        StatAcc {
+            min: self.min.min(o.min),
+            max: self.max.max(o.max),
+            sum: self.sum + o.sum,
+            n: self.n + o.n,
+        }
+    }
+    fn stat(self) -> Stat {
+        if self.n == 0 {
+            return Stat {
+                min: f64::NAN,
+                mean: f64::NAN,
+                max: f64::NAN,
+                count: 0,
+            };
+        }
+        Stat {
+            min: self.min,
+            mean: self.sum / self.n as f64,
+            max: self.max,
+            count: self.n,
+        }
+    }
+}
+
+/// Equal bins from `lo` to `hi`; values outside (or NaN) go to the end
+/// bins, so the counts always add up to the number of values.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Histogram {
+    pub lo: f64,
+    pub hi: f64,
+    pub counts: Vec<u64>,
+}
+
+impl Histogram {
+    pub fn new(lo: f64, hi: f64, bins: usize) -> Histogram {
+        Histogram {
+            lo,
+            hi,
+            counts: vec![0; bins.max(1)],
+        }
+    }
+    pub fn bin_width(&self) -> f64 {
+        (self.hi - self.lo) / self.counts.len() as f64
+    }
+    /// Lower edge of bin `i`.
+    pub fn bin_lo(&self, i: usize) -> f64 {
+        self.lo + i as f64 * self.bin_width()
+    }
+    pub fn bin_of(&self, x: f64) -> usize {
+        let n = self.counts.len();
+        let b = ((x - self.lo) / self.bin_width()).floor();
+        if b >= n as f64 {
+            n - 1
+        } else if b >= 0.0 {
+            b as usize
+        } else {
+            0 // negative or NaN
+        }
+    }
+    pub fn add(&mut self, x: f64) {
+        let b = self.bin_of(x);
+        self.counts[b] += 1;
+    }
+    pub fn total(&self) -> u64 {
+        self.counts.iter().sum()
+    }
+    fn merge(mut self, o: &Histogram) -> Histogram {
+        for (a, b) in self.counts.iter_mut().zip(&o.counts) {
+            *a += b;
+        }
+        self
+    }
+    /// The same range in `k` times wider bins (the last may be narrower).
+    pub fn coarsen(&self, k: usize) -> Histogram {
+        let k = k.max(1);
+        let n = self.counts.len().div_ceil(k);
+        Histogram {
+            lo: self.lo,
+            hi: self.lo + (n * k) as f64 * self.bin_width(),
+            counts: self.counts.chunks(k).map(|c| c.iter().sum()).collect(),
+        }
+    }
+}
+
+/// Threshold for [`QualityReport::share_min_dihedral_below`].
+pub const SMALL_DIHEDRAL: f64 = 10.0;
+
+/// Mesh quality summary with histograms.
+#[derive(Clone, Debug, PartialEq)]
+pub struct QualityReport {
+    pub n_tets: usize,
+    /// Tets with non-positive floating-point volume.
+    pub n_inverted: usize,
+    /// Tets left out because a point id is out of range.
+    pub n_skipped: usize,
+    pub min_dihedral: Stat,
+    pub max_dihedral: Stat,
+    pub radius_ratio: Stat,
+    pub mean_ratio: Stat,
+    /// All six dihedral angles of every tet, 1-degree bins over [0, 180].
+    pub dihedral_hist: Histogram,
+    /// Smallest dihedral angle per tet, 1-degree bins over [0, 180].
+    pub min_dihedral_hist: Histogram,
+    /// Largest dihedral angle per tet, 1-degree bins over [0, 180].
+    pub max_dihedral_hist: Histogram,
+    /// 0.05 bins over [0, 1] (inverted tets in the first bin).
+    pub radius_ratio_hist: Histogram,
+    pub mean_ratio_hist: Histogram,
+    /// Share (0..1) of tets whose smallest dihedral is below 10 degrees.
+    pub share_min_dihedral_below: f64,
+    /// Edge length over target size, once per edge (with a size function).
+    pub edge_ratio: Option<Stat>,
+    /// 0.1 bins over [0, 3] (longer edges in the last bin).
+    pub edge_ratio_hist: Option<Histogram>,
+}
+
+struct Acc {
+    skipped: usize,
+    inverted: usize,
+    small: usize,
+    s: [StatAcc; 4],
+    h: [Histogram; 5],
+}
+impl Acc {
+    fn new() -> Acc {
+        Acc {
+            skipped: 0,
+            inverted: 0,
+            small: 0,
+            s: [StatAcc::EMPTY; 4],
+            h: [
+                Histogram::new(0.0, 180.0, 180),
+                Histogram::new(0.0, 180.0, 180),
+                Histogram::new(0.0, 180.0, 180),
+                Histogram::new(0.0, 1.0, 20),
+                Histogram::new(0.0, 1.0, 20),
+            ],
+        }
+    }
+    fn merge(self, o: Acc) -> Acc {
+        let [a0, a1, a2, a3, a4] = self.h;
+        Acc {
+            skipped: self.skipped + o.skipped,
+            inverted: self.inverted + o.inverted,
+            small: self.small + o.small,
+            s: [0, 1, 2, 3].map(|i| self.s[i].merge(o.s[i])),
+            h: [
+                a0.merge(&o.h[0]),
+                a1.merge(&o.h[1]),
+                a2.merge(&o.h[2]),
+                a3.merge(&o.h[3]),
+                a4.merge(&o.h[4]),
+            ],
+        }
+    }
+}
+
+impl QualityReport {
+    /// Shape quality of every tet (no edge-length measure).
+    pub fn new(mesh: &TetMesh) -> QualityReport {
+        Self::compute(mesh, None::<fn(P3) -> f64>)
+    }
+
+    /// Shape quality plus edge length relative to the target size `size`.
+    pub fn with_size(mesh: &TetMesh, size: impl Fn(P3) -> f64 + Sync) -> QualityReport {
+        Self::compute(mesh, Some(size))
+    }
+
+    fn compute(mesh: &TetMesh, size: Option<impl Fn(P3) -> f64 + Sync>) -> QualityReport {
+        let acc = mesh
+            .tets
+            .par_iter()
+            .fold(Acc::new, |mut a, t| {
+                let Some(p) = tet_coords(mesh, t) else {
+                    a.skipped += 1;
+                    return a;
+                };
+                let d = dihedral_angles(p);
+                let q = TetQuality {
+                    min_dihedral: d.iter().copied().fold(f64::INFINITY, f64::min),
+                    max_dihedral: d.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+                    radius_ratio: radius_ratio(p),
+                    mean_ratio: mean_ratio(p),
+                    volume: tet_volume6(p[0], p[1], p[2], p[3]),
+                };
+                if q.volume.is_nan() || q.volume <= 0.0 {
+                    a.inverted += 1;
+                }
+                if q.min_dihedral.is_nan() || q.min_dihedral < SMALL_DIHEDRAL {
+                    a.small += 1;
+                }
+                for x in d {
+                    a.h[0].add(x);
+                }
+                let v = [q.min_dihedral, q.max_dihedral, q.radius_ratio, q.mean_ratio];
+                for (i, x) in v.into_iter().enumerate() {
+                    a.s[i].add(x);
+                    a.h[i + 1].add(x);
+                }
+                a
+            })
+            .reduce(Acc::new, Acc::merge);
+        let n = mesh.tets.len();
+        let measured = n - acc.skipped;
+        let (edge_ratio, edge_ratio_hist) = match size {
+            None => (None, None),
+            Some(h) => {
+                let r = edge_size_ratios(mesh, h);
+                let mut s = StatAcc::EMPTY;
+                let mut hist = Histogram::new(0.0, 3.0, 30);
+                for &x in &r {
+                    s.add(x);
+                    hist.add(x);
+                }
+                (Some(s.stat()), Some(hist))
+            }
+        };
+        let [dihedral_hist, min_dihedral_hist, max_dihedral_hist, radius_ratio_hist, mean_ratio_hist] =
+            acc.h;
+        QualityReport {
+            n_tets: n,
+            n_inverted: acc.inverted,
+            n_skipped: acc.skipped,
+            min_dihedral: acc.s[0].stat(),
+            max_dihedral: acc.s[1].stat(),
+            radius_ratio: acc.s[2].stat(),
+            mean_ratio: acc.s[3].stat(),
+            dihedral_hist,
+            min_dihedral_hist,
+            max_dihedral_hist,
+            radius_ratio_hist,
+            mean_ratio_hist,
+            share_min_dihedral_below: if measured == 0 {
+                0.0
+            } else {
+                acc.small as f64 / measured as f64
+            },
+            edge_ratio,
+            edge_ratio_hist,
+        }
+    }
+}
+
+fn write_hist(f: &mut fmt::Formatter<'_>, title: &str, h: &Histogram, prec: usize) -> fmt::Result {
+    let total = h.total().max(1);
+    let peak = h.counts.iter().copied().max().unwrap_or(0).max(1);
+    // Skip empty bins at both ends: the table shows where the mass is.
+    let first = h.counts.iter().position(|&c| c > 0).unwrap_or(0);
+    let last = h.counts.iter().rposition(|&c| c > 0).unwrap_or(0);
+    writeln!(f, "{title}")?;
+    for i in first..=last {
+        let c = h.counts[i];
+        let bar = ((c as f64 / peak as f64) * 30.0).round() as usize;
+        writeln!(
+            f,
+            "  {:>7.prec$} - {:<7.prec$} {:>10} {:>6.2}% {}",
+            h.bin_lo(i),
+            h.bin_lo(i + 1),
+            c,
+            100.0 * c as f64 / total as f64,
+            "#".repeat(if c > 0 { bar.max(1) } else { 0 }),
+        )?;
+    }
+    Ok(())
+}
+
+impl fmt::Display for QualityReport {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        writeln!(
+            f,
+            "quality of {} tets ({} inverted, {} skipped)",
+            self.n_tets, self.n_inverted, self.n_skipped
+        )?;
+        writeln!(
+            f,
+            "  {:<16} {:>10} {:>10} {:>10}",
+            "measure", "min", "mean", "max"
+        )?;
+        let mut row = |name: &str, s: &Stat, prec: usize| {
+            writeln!(
+                f,
+                "  {:<16} {:>10.prec$} {:>10.prec$} {:>10.prec$}",
+                name, s.min, s.mean, s.max
+            )
+        };
+        row("min dihedral deg", &self.min_dihedral, 2)?;
+        row("max dihedral deg", &self.max_dihedral, 2)?;
+        row("radius ratio", &self.radius_ratio, 4)?;
+        row("mean ratio", &self.mean_ratio, 4)?;
+        if let Some(s) = &self.edge_ratio {
+            row("edge / size", s, 4)?;
+        }
+        writeln!(
+            f,
+            "  tets with min dihedral < {SMALL_DIHEDRAL} deg: {:.4}%",
+            100.0 * self.share_min_dihedral_below
+        )?;
+        write_hist(
+            f,
+            "min dihedral per tet (deg):",
+            &self.min_dihedral_hist.coarsen(5),
+            0,
+        )?;
+        write_hist(
+            f,
+            "max dihedral per tet (deg):",
+            &self.max_dihedral_hist.coarsen(5),
+            0,
+        )?;
+        write_hist(f, "radius ratio:", &self.radius_ratio_hist.coarsen(2), 2)?;
+        if let Some(h) = &self.edge_ratio_hist {
+            write_hist(f, "edge length / target size:", &h.coarsen(2), 1)?;
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,170 @@
+//! Quality measures on known shapes, and the report on box meshes.
+use parafront_geom::{orient3d, P3};
+use parafront_mesh::generate::box_mesh;
+use parafront_mesh::quality::*;
+use parafront_mesh::*;
+
+fn regular() -> [P3; 4] {
+    // Alternate corners of a cube: a regular tet, positively oriented.
+    let p = [
+        [1.0, -1.0, -1.0],
+        [1.0, 1.0, 1.0],
+        [-1.0, 1.0, -1.0],
+        [-1.0, -1.0, 1.0],
+    ];
+    assert!(orient3d(p[0], p[1], p[2], p[3]) > 0.0);
+    p
+}
+
+#[test]
+fn regular_tet_is_perfect() {
+    let q = tet_quality(regular());
+    assert!((q.radius_ratio - 1.0).abs() < 1e-14, "{q:?}");
+    assert!((q.mean_ratio - 1.0).abs() < 1e-14, "{q:?}");
+    for a in dihedral_angles(regular()) {
+        assert!((a - REGULAR_DIHEDRAL).abs() < 1e-12, "{a}");
+    }
+    assert!((REGULAR_DIHEDRAL - (1.0f64 / 3.0).acos().to_degrees()).abs() < 1e-12);
+    assert!((q.volume - 8.0 / 3.0).abs() < 1e-14);
+}
+
+#[test]
+fn sliver_is_near_zero() {
+    // Four nearly coplanar points around a square: the classic sliver.
+    for h in [1e-2, 1e-4, 1e-8] {
+        let mut p = [
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, h],
+            [-1.0, 0.0, 0.0],
+            [0.0, -1.0, h],
+        ];
+        if orient3d(p[0], p[1], p[2], p[3]) < 0.0 {
+            p.swap(0, 1);
+        }
+        let q = tet_quality(p);
+        assert!(q.volume > 0.0);
+        assert!(
+            q.radius_ratio > 0.0 && q.radius_ratio < 10.0 * h,
+            "{h} {q:?}"
+        );
+        assert!(
+            q.mean_ratio > 0.0 && q.mean_ratio < 10.0 * h.powf(2.0 / 3.0),
+            "{h} {q:?}"
+        );
+        assert!(q.min_dihedral < 300.0 * h, "{h} {q:?}");
+        assert!(q.max_dihedral > 180.0 - 300.0 * h, "{h} {q:?}");
+    }
+    // Exactly flat: zero, not NaN.
+    let q = tet_quality([[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 1.0, 0.0]]);
+    assert_eq!((q.radius_ratio, q.mean_ratio, q.volume), (0.0, 0.0, 0.0));
+    // Inverted: negative ratios.
+    let mut p = regular();
+    p.swap(0, 1);
+    let q = tet_quality(p);
+    assert!((q.radius_ratio + 1.0).abs() < 1e-14 && (q.mean_ratio + 1.0).abs() < 1e-14);
+}
+
+#[test]
+fn kuhn_tets_and_box_report() {
+    let m = box_mesh(3, 4, 5, [0.0; 3], [3.0, 4.0, 5.0]);
+    let r = QualityReport::with_size(&m, |_| 1.0);
+    assert_eq!(r.n_tets, 360);
+    assert_eq!((r.n_inverted, r.n_skipped), (0, 0));
+    // The Kuhn tet has dihedral angles 45, 60 and 90 degrees.
+    assert!((r.min_dihedral.min - 45.0).abs() < 1e-9 && (r.min_dihedral.max - 45.0).abs() < 1e-9);
+    assert!((r.max_dihedral.max - 90.0).abs() < 1e-9);
+    let mut d = dihedral_angles(m.tet_points(TetId(0)));
+    d.sort_by(f64::total_cmp);
+    let want = [45.0, 45.0, 60.0, 90.0, 90.0, 90.0];
+    for (a, b) in d.iter().zip(want) {
+        assert!((a - b).abs() < 1e-9, "{d:?}");
+    }
+    // Unit Kuhn tet: r = 3V / area = 0.5 / (1 + sqrt 2), R = sqrt 3 / 2.
+    let rr = 3.0 * (0.5 / (1.0 + 2f64.sqrt())) / (3f64.sqrt() / 2.0);
+    assert!(
+        (r.radius_ratio.mean - rr).abs() < 1e-12,
+        "{}",
+        r.radius_ratio.mean
+    );
+    assert_eq!(r.share_min_dihedral_below, 0.0);
+    assert_eq!(r.dihedral_hist.total(), 6 * 360);
+    assert_eq!(r.min_dihedral_hist.total(), 360);
+    assert_eq!(r.radius_ratio_hist.total(), 360);
+    assert_eq!(
+        r.radius_ratio_hist.counts[r.radius_ratio_hist.bin_of(rr)],
+        360
+    );
+    assert_eq!(r.dihedral_hist.counts.len(), 180);
+    assert_eq!(r.radius_ratio_hist.counts.len(), 20);
+    // 90-degree angles: 3 per tet, in the 90 bin (or 89 by rounding).
+    assert_eq!(
+        r.dihedral_hist.counts[89] + r.dihedral_hist.counts[90],
+        3 * 360
+    );
+    // Edges: axis (length 1), face diagonals (sqrt 2), cell diagonals (sqrt 3).
+    let e = r.edge_ratio.unwrap();
+    let (nx, ny, nz) = (3, 4, 5);
+    let axis = nx * (ny + 1) * (nz + 1) + (nx + 1) * ny * (nz + 1) + (nx + 1) * (ny + 1) * nz;
+    let diag = nx * ny * (nz + 1) + nx * (ny + 1) * nz + (nx + 1) * ny * nz;
+    assert_eq!(e.count, axis + diag + nx * ny * nz);
+    assert!((e.min - 1.0).abs() < 1e-12 && (e.max - 3f64.sqrt()).abs() < 1e-12);
+    let s = r.to_string();
+    for w in [
+        "360 tets",
+        "min dihedral",
+        "radius ratio",
+        "mean ratio",
+        "edge / size",
+        "45.00",
+    ] {
+        assert!(s.contains(w), "{w} missing from:\n{s}");
+    }
+}
+
+#[test]
+fn report_counts_bad_tets() {
+    let mut m = box_mesh(2, 2, 2, [0.0; 3], [1.0; 3]);
+    // Flatten a neighbourhood: the centre point onto a cell face plane.
+    m.points[13] = [0.5, 0.5, 0.999];
+    m.tets
+        .push([PointId(0), PointId(1), PointId(2), PointId(99)]);
+    let mut flipped = m.tets[0];
+    flipped.swap(0, 1);
+    m.tets.push(flipped);
+    m.region.extend([0, 0]);
+    let r = QualityReport::new(&m);
+    assert_eq!(r.n_skipped, 1);
+    assert_eq!(r.n_inverted, 1);
+    assert!(r.share_min_dihedral_below > 0.0);
+    assert!(r.min_dihedral.min < 10.0);
+    assert_eq!(r.min_dihedral_hist.total() as usize, m.tets.len() - 1);
+    assert!(r.edge_ratio.is_none());
+    assert!(r.to_string().contains("1 skipped"));
+    // Per-tet values agree with the report's extremes.
+    let q = tet_qualities(&m);
+    assert!(q[q.len() - 2].is_none());
+    assert!(q.last().unwrap().unwrap().radius_ratio < 0.0);
+    let lo = q
+        .iter()
+        .flatten()
+        .map(|q| q.min_dihedral)
+        .fold(f64::INFINITY, f64::min);
+    assert_eq!(lo, r.min_dihedral.min);
+    assert_eq!(r.radius_ratio.min, q.last().unwrap().unwrap().radius_ratio);
+}
+
+#[test]
+fn histogram_binning() {
+    let mut h = Histogram::new(0.0, 1.0, 20);
+    for x in [-0.5, 0.0, 0.049, 0.05, 0.99, 1.0, 7.0, f64::NAN] {
+        h.add(x);
+    }
+    assert_eq!(h.total(), 8);
+    assert_eq!(h.counts[0], 4);
+    assert_eq!(h.counts[1], 1);
+    assert_eq!(h.counts[19], 3);
+    let c = h.coarsen(3);
+    assert_eq!(c.counts.len(), 7);
+    assert_eq!(c.total(), 8);
+    assert!((c.bin_width() - 0.15).abs() < 1e-12);
+}

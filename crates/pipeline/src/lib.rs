@@ -1,0 +1,160 @@
+//! The pipeline: surface (validated) -> size field -> front, one material
+//! region at a time -> checked `TetMesh`. Later stages (DDG, parallel
+//! passes, redistribution, improvement) slot in between the front and the
+//! check. The CLI is a thin layer over [`mesh_surface`].
+
+mod regions;
+
+pub use regions::{material_regions, RegionFront};
+
+use parafront_front::{advance, FrontError, FrontInput, FrontOptions, SizeMode};
+use parafront_mesh::{CheckError, FaceRef, PointId, QualityReport, TetMesh};
+use parafront_size::{SizeError, SizeField, SizeOptions, Sizing};
+use parafront_surface::validate::{validate, Report};
+use parafront_surface::Surface;
+use serde::{Deserialize, Serialize};
+use std::time::Instant;
+
+/// Every option of `parafront mesh`, with documented defaults. The CLI
+/// flags and a TOML file (`--config`) both map onto it.
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MeshOptions {
+    /// The size field (AG1): global `h`, `hmin`, `hmax`, `gradation`,
+    /// sources, per-patch sizes, background grid.
+    #[serde(default)]
+    pub size: SizeOptions,
+    /// Worker threads (0: all cores).
+    #[serde(default)]
+    pub threads: usize,
+    /// Skip the final validity check (not recommended; it is cheap).
+    #[serde(default)]
+    pub no_check: bool,
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum MeshError {
+    #[error("the surface is not valid for meshing:\n{0}")]
+    InvalidSurface(Box<Report>),
+    #[error("size field: {0}")]
+    Size(#[from] SizeError),
+    #[error("region {region}: {source}")]
+    Front { region: usize, source: FrontError },
+    #[error("the generated mesh failed its check (this is a bug in parafront): {0}")]
+    Check(#[from] CheckError),
+    #[error("{0}")]
+    Topology(String),
+}
+
+/// What a run made, for the summary line and the benchmark tables.
+#[derive(Clone, Debug, Default)]
+pub struct Summary {
+    pub tets: usize,
+    pub points: usize,
+    pub regions: usize,
+    /// (stage, seconds), in pipeline order.
+    pub stages: Vec<(&'static str, f64)>,
+    pub recovery_rounds: u32,
+    pub tets_removed: usize,
+}
+
+impl Summary {
+    pub fn seconds(&self, stage: &str) -> f64 {
+        self.stages
+            .iter()
+            .filter(|s| s.0 == stage)
+            .map(|s| s.1)
+            .sum()
+    }
+    pub fn total_seconds(&self) -> f64 {
+        self.stages.iter().map(|s| s.1).sum()
+    }
+}
+
+/// Mesh the volume bounded by `s`. The result keeps the surface triangle
+/// for triangle (its points come first, with their ids) and has passed
+/// `check_against_surface` unless `no_check`.
+pub fn mesh_surface(s: &Surface, opts: &MeshOptions) -> Result<(TetMesh, Summary), MeshError> {
+    let mut sum = Summary::default();
+    let t0 = Instant::now();
+    let report = validate(s);
+    if !report.is_valid() {
+        return Err(MeshError::InvalidSurface(Box::new(report)));
+    }
+    let fronts = material_regions(s, &report.shells);
+    sum.stages.push(("validate", t0.elapsed().as_secs_f64()));
+
+    let t0 = Instant::now();
+    let sizing = Sizing::build(s, &opts.size, None)?;
+    sum.stages.push(("size field", t0.elapsed().as_secs_f64()));
+
+    let t0 = Instant::now();
+    let mut mesh = TetMesh {
+        points: s.points.clone(),
+        bnd_tris: s.tris.iter().map(|t| t.map(PointId)).collect(),
+        bnd_patch: s.patch.clone(),
+        ..Default::default()
+    };
+    let field = |p| sizing.size(p);
+    for (r, rf) in fronts.iter().enumerate() {
+        let input = FrontInput {
+            points: rf.points.iter().map(|&i| s.points[i as usize]).collect(),
+            point_size: rf
+                .points
+                .iter()
+                .map(|&i| sizing.surface_point_sizes()[i as usize])
+                .collect(),
+            faces: rf.faces.clone(),
+        };
+        let n_in = rf.points.len();
+        let res = advance(
+            input,
+            SizeMode::Field(&field),
+            &parafront_front::Everywhere,
+            &FrontOptions::default(),
+        )
+        .map_err(|e| MeshError::Front {
+            region: r,
+            source: e,
+        })?;
+        // Local ids: the region's surface points, then its new points.
+        let base = mesh.points.len() as u32;
+        let map = |p: u32| {
+            if (p as usize) < n_in {
+                rf.points[p as usize]
+            } else {
+                base + p - n_in as u32
+            }
+        };
+        mesh.points.extend_from_slice(&res.points[n_in..]);
+        mesh.tets
+            .extend(res.tets.iter().map(|t| t.map(|p| PointId(map(p)))));
+        mesh.region
+            .extend(std::iter::repeat_n(rf.region_id, res.tets.len()));
+        sum.recovery_rounds += res.stats.recovery_rounds;
+        sum.tets_removed += res.stats.tets_removed;
+    }
+    sum.stages.push(("front", t0.elapsed().as_secs_f64()));
+
+    let t0 = Instant::now();
+    mesh.build_adjacency()
+        .map_err(|e| MeshError::Topology(e.to_string()))?;
+    if !opts.no_check {
+        mesh.check_against_surface(&s.tris)?;
+    }
+    sum.stages.push(("check", t0.elapsed().as_secs_f64()));
+    sum.tets = mesh.tets.len();
+    sum.points = mesh.points.len();
+    sum.regions = fronts.len();
+    let _ = FaceRef(0);
+    Ok((mesh, sum))
+}
+
+/// Quality of `mesh` with edge lengths measured against the size field
+/// the run used.
+pub fn quality_report(mesh: &TetMesh, s: &Surface, opts: &MeshOptions) -> QualityReport {
+    match Sizing::build(s, &opts.size, None) {
+        Ok(sz) => QualityReport::with_size(mesh, |p| sz.size(p)),
+        Err(_) => QualityReport::new(mesh),
+    }
+}

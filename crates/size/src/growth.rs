@@ -1,0 +1,465 @@
+//! Size grown from the surface (AG1 + AG3): with seeds `(x_i, h_i)` (surface
+//! points and their sizes) and slope `c = g - 1`,
+//!
+//! `f(x) = min_i h_i + c |x - x_i|`,
+//!
+//! the largest c-Lipschitz field that does not exceed any `h_i`.
+//!
+//! Evaluating the min over all seeds is O(N), so an octree is built once:
+//! - each cell carries the seeds that can be the minimum somewhere in it
+//!   (lower bound `h_j + c dist(x_j, cell)` <= an upper bound of `f` on the
+//!   cell), filtered from its parent's; below far cells, seeds that could
+//!   lower `f` by less than 1% are dropped;
+//! - near leaves (a seed within one cell size, at most `NEAR_MAX` seeds after
+//!   a 2x2x2 sub-cell test) evaluate the min over their seeds: exact at the
+//!   surface points whose own size is not dominated by a neighbour's growth
+//!   (the others may lie in far leaves: within 2%);
+//! - far leaves store `f` at their 8 corners and interpolate trilinearly;
+//!   they are split until the interpolant matches `f` at the centre and face
+//!   centres to 2% (over) / 20% (under). The concave kinks where cones meet
+//!   are underestimated (the safe side: smaller elements).
+//!
+//! Queries descend the octree (no allocation), then do <= `NEAR_MAX` cone
+//! evaluations or one trilinear interpolation. A [`GrowthCursor`] remembers
+//! the last leaf, so nearby queries skip the descent.
+use parafront_geom::{dist, P3};
+use rayon::prelude::*;
+
+/// Cells with a seed closer than this many cell sizes are near leaves.
+const NEAR_FACTOR: f64 = 1.0;
+/// A near cell with more candidates is split (unless forced to be a leaf).
+const NEAR_MAX: usize = 40;
+/// Candidate lists of forced leaves are cut to this many (smallest bound).
+const FORCED_MAX: usize = 256;
+/// Far cells: allowed relative over- / under-estimate at the test points.
+const TOL_OVER: f64 = 0.02;
+const TOL_UNDER: f64 = 0.2;
+/// Split far cells pass their children only the seeds that may lower f by
+/// more than this fraction (the seed bounding f on the child always stays).
+const PRUNE_EPS: f64 = 0.01;
+const MAX_DEPTH: u32 = 24;
+
+const KIND_SHIFT: u32 = 30;
+const IDX_MASK: u32 = (1 << KIND_SHIFT) - 1;
+const K_INTERNAL: u32 = 0;
+const K_NEAR: u32 = 1;
+const K_FAR: u32 = 2;
+
+/// A seed: position and size, kept together for cache locality.
+#[derive(Clone, Copy, Debug)]
+struct Seed {
+    p: P3,
+    h: f64,
+}
+
+#[inline(always)]
+fn point_box_d2(p: P3, lo: P3, hi: P3) -> f64 {
+    let mut d2 = 0.0;
+    for k in 0..3 {
+        let e = (lo[k] - p[k]).max(p[k] - hi[k]).max(0.0);
+        d2 += e * e;
+    }
+    d2
+}
+
+enum Decision {
+    Near(Vec<u32>),
+    Far([f64; 8]),
+    Split(Vec<Vec<u32>>),
+}
+
+/// Build statistics (for reports and tests).
+#[derive(Clone, Debug, Default)]
+pub struct GrowthStats {
+    pub seeds: usize,
+    pub nodes: usize,
+    pub near_leaves: usize,
+    pub far_leaves: usize,
+    pub candidates: usize,
+    /// Near leaves forced by the depth or node cap whose list was cut: the
+    /// field may be too large there.
+    pub truncated: usize,
+    pub depth: u32,
+    pub bytes: usize,
+}
+
+/// Remembers the last octree leaf for [`SurfaceGrowth::size_with`].
+#[derive(Clone, Copy, Debug)]
+pub struct GrowthCursor {
+    code: u32,
+    lo: P3,
+    s: f64,
+}
+
+impl Default for GrowthCursor {
+    fn default() -> Self {
+        GrowthCursor {
+            code: u32::MAX,
+            lo: [0.0; 3],
+            s: -1.0,
+        }
+    }
+}
+
+/// The surface-grown size field (see the module doc).
+#[derive(Clone, Debug)]
+pub struct SurfaceGrowth {
+    /// Seeds in Morton order (nearby seeds nearby in memory).
+    seeds: Vec<Seed>,
+    c: f64,
+    root_lo: P3,
+    root_s: f64,
+    nodes: Vec<u32>,
+    /// (start, len) into `cand` per near leaf.
+    near: Vec<(u32, u32)>,
+    /// Seed indices of the near leaves.
+    cand: Vec<u32>,
+    far: Vec<[f64; 8]>,
+    stats: GrowthStats,
+}
+
+/// A cell waiting for its decision, with the seeds that can be the minimum
+/// somewhere in it (a subset of its parent's).
+struct Pending {
+    node: usize,
+    lo: P3,
+    s: f64,
+    depth: u32,
+    list: Vec<u32>,
+}
+
+impl SurfaceGrowth {
+    /// `seeds`: (position, size > 0) pairs; `slope` = gradation - 1 >= 0.
+    /// Positions must be finite. With no seeds the field is +inf.
+    pub fn new(seeds: &[(P3, f64)], slope: f64) -> SurfaceGrowth {
+        let mut bb = parafront_geom::Aabb::from_points(seeds.iter().map(|s| &s.0));
+        if bb.is_empty() {
+            bb = parafront_geom::Aabb {
+                min: [0.0; 3],
+                max: [0.0; 3],
+            };
+        }
+        let ext = (0..3).map(|k| bb.max[k] - bb.min[k]).fold(0.0, f64::max);
+        // A margin so that points just outside the surface's box are not clamped.
+        let root_s = (ext * 1.1).max(1e-300);
+        let cen = bb.center();
+        let root_lo = [
+            cen[0] - root_s / 2.0,
+            cen[1] - root_s / 2.0,
+            cen[2] - root_s / 2.0,
+        ];
+        let morton = |p: P3| {
+            let mut key = 0u64;
+            let q =
+                [0, 1, 2].map(|k| (((p[k] - root_lo[k]) / root_s * 1048575.0) as u64).min(1048575));
+            for bit in (0..20).rev() {
+                for qk in q {
+                    key = (key << 1) | ((qk >> bit) & 1);
+                }
+            }
+            key
+        };
+        let mut s: Vec<Seed> = seeds.iter().map(|&(p, h)| Seed { p, h }).collect();
+        s.sort_by_cached_key(|sd| morton(sd.p));
+        let mut g = SurfaceGrowth {
+            seeds: s,
+            c: slope,
+            root_lo,
+            root_s,
+            nodes: vec![0],
+            near: Vec::new(),
+            cand: Vec::new(),
+            far: Vec::new(),
+            stats: GrowthStats {
+                seeds: seeds.len(),
+                ..Default::default()
+            },
+        };
+        if slope > 0.0 {
+            g.build_octree();
+        } else {
+            // No growth: the field is the smallest seed size everywhere.
+            let hmin = g.seeds.iter().map(|s| s.h).fold(f64::INFINITY, f64::min);
+            g.nodes[0] = K_FAR << KIND_SHIFT;
+            g.far.push([hmin; 8]);
+        }
+        g
+    }
+
+    #[inline(always)]
+    fn cone(&self, j: u32, x: P3) -> f64 {
+        let sd = &self.seeds[j as usize];
+        sd.h + self.c * dist(x, sd.p)
+    }
+
+    #[inline]
+    fn min_over(&self, list: &[u32], x: P3) -> f64 {
+        list.iter()
+            .map(|&j| self.cone(j, x))
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    /// The seeds of `list` that can be the minimum somewhere in the cell
+    /// `[lo, lo+s]`: lower bound `h_j + c dist(x_j, cell)` <= an upper bound
+    /// of `f` on the cell. Exact when `list` is exact for a box around the cell.
+    fn filter(&self, list: &[u32], lo: P3, s: f64, eps: f64, out: &mut Vec<u32>) {
+        let hi = [lo[0] + s, lo[1] + s, lo[2] + s];
+        let cen = [lo[0] + s / 2.0, lo[1] + s / 2.0, lo[2] + s / 2.0];
+        let (mut best, mut fc) = (u32::MAX, f64::INFINITY);
+        for &j in list {
+            let v = self.cone(j, cen);
+            if v < fc {
+                (best, fc) = (j, v);
+            }
+        }
+        // f is c-Lipschitz: f <= f(centre) + c * half-diagonal on the cell.
+        let u = (fc + self.c * s * 0.5 * 3f64.sqrt()) * (1.0 + 1e-12);
+        let start = out.len();
+        for &j in list {
+            let sd = &self.seeds[j as usize];
+            if (sd.h + self.c * point_box_d2(sd.p, lo, hi).sqrt()) * (1.0 + eps) <= u {
+                out.push(j);
+            }
+        }
+        // With eps > 0 the seed that bounds f on the cell must stay.
+        if best != u32::MAX && !out[start..].contains(&best) {
+            out.push(best);
+        }
+    }
+
+    fn build_octree(&mut self) {
+        // Bounded memory whatever the input: past the cap every cell is a leaf.
+        let cap = (32 * self.seeds.len() + 4096).min(1 << 28);
+        let mut pending = vec![Pending {
+            node: 0,
+            lo: self.root_lo,
+            s: self.root_s,
+            depth: 0,
+            list: (0..self.seeds.len() as u32).collect(),
+        }];
+        while !pending.is_empty() {
+            let force = self.nodes.len() > cap;
+            let decisions: Vec<Decision> = pending
+                .par_iter()
+                .map(|p| self.classify(p, force || p.depth >= MAX_DEPTH))
+                .collect();
+            let mut next = Vec::new();
+            for (p, dec) in pending.into_iter().zip(decisions) {
+                self.stats.depth = self.stats.depth.max(p.depth);
+                match dec {
+                    Decision::Near(list) => {
+                        self.nodes[p.node] = (K_NEAR << KIND_SHIFT) | self.near.len() as u32;
+                        self.near.push((self.cand.len() as u32, list.len() as u32));
+                        self.cand.extend_from_slice(&list);
+                    }
+                    Decision::Far(v) => {
+                        self.nodes[p.node] = (K_FAR << KIND_SHIFT) | self.far.len() as u32;
+                        self.far.push(v);
+                    }
+                    Decision::Split(lists) => {
+                        let first = self.nodes.len();
+                        self.nodes[p.node] = first as u32;
+                        self.nodes.extend_from_slice(&[0; 8]);
+                        let h = p.s / 2.0;
+                        for (ch, list) in lists.into_iter().enumerate() {
+                            next.push(Pending {
+                                node: first + ch,
+                                lo: corner(p.lo, h, ch),
+                                s: h,
+                                depth: p.depth + 1,
+                                list,
+                            });
+                        }
+                    }
+                }
+            }
+            pending = next;
+        }
+        let st = &mut self.stats;
+        st.nodes = self.nodes.len();
+        st.near_leaves = self.near.len();
+        st.far_leaves = self.far.len();
+        st.candidates = self.cand.len();
+        st.bytes = self.nodes.len() * 4
+            + self.near.len() * 8
+            + self.cand.len() * 4
+            + self.far.len() * 64
+            + self.seeds.len() * 32;
+    }
+
+    /// `eps > 0` drops seeds that improve `f` by less than that fraction.
+    fn split(&self, p: &Pending, eps: f64) -> Decision {
+        let h = p.s / 2.0;
+        let lists = (0..8)
+            .map(|ch| {
+                let mut l = Vec::new();
+                self.filter(&p.list, corner(p.lo, h, ch), h, eps, &mut l);
+                l
+            })
+            .collect();
+        Decision::Split(lists)
+    }
+
+    fn classify(&self, p: &Pending, force: bool) -> Decision {
+        let (lo, s) = (p.lo, p.s);
+        let hi = [lo[0] + s, lo[1] + s, lo[2] + s];
+        let r2 = p
+            .list
+            .iter()
+            .map(|&j| point_box_d2(self.seeds[j as usize].p, lo, hi))
+            .fold(f64::INFINITY, f64::min);
+        if r2 < (NEAR_FACTOR * s).powi(2) {
+            if p.list.len() <= NEAR_MAX {
+                return Decision::Near(p.list.clone());
+            }
+            if p.list.len() <= 8 * NEAR_MAX || force {
+                // Tighter: union of the sets of the 2x2x2 sub-cells.
+                let h = s / 2.0;
+                let mut list = Vec::new();
+                for ch in 0..8 {
+                    self.filter(&p.list, corner(lo, h, ch), h, 0.0, &mut list);
+                }
+                list.sort_unstable();
+                list.dedup();
+                if list.len() <= NEAR_MAX {
+                    return Decision::Near(list);
+                }
+                if force {
+                    if list.len() > FORCED_MAX {
+                        let key = |j: &u32| {
+                            let sd = &self.seeds[*j as usize];
+                            sd.h + self.c * point_box_d2(sd.p, lo, hi).sqrt()
+                        };
+                        list.sort_by(|a, b| key(a).total_cmp(&key(b)));
+                        list.truncate(FORCED_MAX);
+                    }
+                    return Decision::Near(list);
+                }
+            }
+            // Exact lists below near cells: cells holding seeds stay exact.
+            return self.split(p, 0.0);
+        }
+        let mut v = [0.0f64; 8];
+        for (ch, vc) in v.iter_mut().enumerate() {
+            *vc = self.min_over(&p.list, corner(lo, s, ch));
+        }
+        if !force {
+            let tests = [
+                [0.5, 0.5, 0.5],
+                [0.0, 0.5, 0.5],
+                [1.0, 0.5, 0.5],
+                [0.5, 0.0, 0.5],
+                [0.5, 1.0, 0.5],
+                [0.5, 0.5, 0.0],
+                [0.5, 0.5, 1.0],
+            ];
+            for t in tests {
+                let x = [lo[0] + t[0] * s, lo[1] + t[1] * s, lo[2] + t[2] * s];
+                let f = self.min_over(&p.list, x);
+                let i = trilinear(&v, t);
+                if i > f * (1.0 + TOL_OVER) || i < f * (1.0 - TOL_UNDER) {
+                    return self.split(p, PRUNE_EPS);
+                }
+            }
+        }
+        Decision::Far(v)
+    }
+
+    /// The field at `p`. Points outside the octree's cube (the seeds' box
+    /// plus 5%) are clamped to it, which can only lower the value there.
+    #[inline]
+    pub fn size(&self, p: P3) -> f64 {
+        let mut cur = GrowthCursor::default();
+        self.size_with(p, &mut cur)
+    }
+
+    /// As [`size`](Self::size), starting from the cursor's leaf when `p` lies in it.
+    #[inline]
+    pub fn size_with(&self, p: P3, cur: &mut GrowthCursor) -> f64 {
+        let s0 = self.root_s;
+        let q = [
+            p[0].clamp(self.root_lo[0], self.root_lo[0] + s0),
+            p[1].clamp(self.root_lo[1], self.root_lo[1] + s0),
+            p[2].clamp(self.root_lo[2], self.root_lo[2] + s0),
+        ];
+        let inside = |lo: &P3, s: f64| (0..3).all(|k| q[k] >= lo[k] && q[k] <= lo[k] + s);
+        if cur.code == u32::MAX || !inside(&cur.lo, cur.s) {
+            let mut lo = self.root_lo;
+            let mut s = s0;
+            let mut code = self.nodes[0];
+            while code >> KIND_SHIFT == K_INTERNAL {
+                s *= 0.5;
+                let mut ch = 0;
+                for k in 0..3 {
+                    if q[k] >= lo[k] + s {
+                        ch |= 1 << k;
+                        lo[k] += s;
+                    }
+                }
+                code = self.nodes[(code & IDX_MASK) as usize + ch];
+            }
+            *cur = GrowthCursor { code, lo, s };
+        }
+        let idx = (cur.code & IDX_MASK) as usize;
+        if cur.code >> KIND_SHIFT == K_NEAR {
+            let (a, l) = self.near[idx];
+            let mut best = f64::INFINITY;
+            for &j in &self.cand[a as usize..(a + l) as usize] {
+                best = best.min(self.cone(j, q));
+            }
+            best
+        } else {
+            let t = [
+                ((q[0] - cur.lo[0]) / cur.s).clamp(0.0, 1.0),
+                ((q[1] - cur.lo[1]) / cur.s).clamp(0.0, 1.0),
+                ((q[2] - cur.lo[2]) / cur.s).clamp(0.0, 1.0),
+            ];
+            let v = &self.far[idx];
+            trilinear(v, t)
+        }
+    }
+
+    /// The leaf containing `p`: (is a near leaf, its corner, its size).
+    pub fn leaf_of(&self, p: P3) -> (bool, P3, f64) {
+        let mut cur = GrowthCursor::default();
+        self.size_with(p, &mut cur);
+        (cur.code >> KIND_SHIFT == K_NEAR, cur.lo, cur.s)
+    }
+
+    /// The exact formula by brute force, O(N): for tests and checks.
+    pub fn exact(&self, p: P3) -> f64 {
+        self.seeds
+            .iter()
+            .map(|s| s.h + self.c * dist(p, s.p))
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    pub fn slope(&self) -> f64 {
+        self.c
+    }
+
+    pub fn stats(&self) -> &GrowthStats {
+        &self.stats
+    }
+}
+
+#[inline(always)]
+fn corner(lo: P3, s: f64, ch: usize) -> P3 {
+    [
+        lo[0] + if ch & 1 != 0 { s } else { 0.0 },
+        lo[1] + if ch & 2 != 0 { s } else { 0.0 },
+        lo[2] + if ch & 4 != 0 { s } else { 0.0 },
+    ]
+}
+
+/// Trilinear interpolation; `v[ch]` at corner `ch` (bit k = upper side in k).
+#[inline(always)]
+fn trilinear(v: &[f64; 8], t: [f64; 3]) -> f64 {
+    let x0 = v[0] + (v[1] - v[0]) * t[0];
+    let x1 = v[2] + (v[3] - v[2]) * t[0];
+    let x2 = v[4] + (v[5] - v[4]) * t[0];
+    let x3 = v[6] + (v[7] - v[6]) * t[0];
+    let y0 = x0 + (x1 - x0) * t[1];
+    let y1 = x2 + (x3 - x2) * t[1];
+    y0 + (y1 - y0) * t[2]
+}
