@@ -32,6 +32,9 @@ enum Cmd {
         /// Output mesh (.vtu, .msh, .mesh).
         #[arg(short, long, default_value = "demo.vtu")]
         output: PathBuf,
+        /// Only validate the demo surface and write it (no volume mesh).
+        #[arg(long)]
+        check_only: bool,
         #[command(flatten)]
         mesh: MeshArgs,
         #[command(flatten)]
@@ -121,12 +124,17 @@ fn main() -> ExitCode {
     let res = match cli.cmd {
         Cmd::Demo {
             output,
+            check_only,
             mesh,
             write,
         } => {
             let s = parafront_surface::generate::demo_part();
-            println!("demo part: block 16x12x6 mm with a drilled hole, a spherical void and an embedded torus");
-            run_mesh(&s, "demo part", &output, &mesh, &write)
+            println!("demo part: block 16x12x6 mm with a drilled hole, a spherical void and an embedded sphere");
+            if check_only {
+                run_demo_check(&s, &output, &write)
+            } else {
+                run_mesh(&s, "demo part", &output, &mesh, &write)
+            }
         }
         Cmd::Mesh {
             surface,
@@ -278,6 +286,31 @@ fn peak_memory_bytes() -> Option<u64> {
     let line = s.lines().find(|l| l.starts_with("VmHWM:"))?;
     let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
     Some(kb * 1024)
+}
+
+/// Validate the built-in surface and write it as a triangle-only mesh.
+fn run_demo_check(s: &Surface, out: &Path, w: &WriteArgs) -> Result<(), Fail> {
+    let report = validate(s);
+    println!("{report}");
+    if !report.is_valid() {
+        return Err(Fail(
+            1,
+            "the built-in demo surface is not valid (a bug)".into(),
+        ));
+    }
+    let mesh = parafront_mesh::TetMesh {
+        points: s.points.clone(),
+        bnd_tris: s
+            .tris
+            .iter()
+            .map(|t| t.map(parafront_mesh::PointId))
+            .collect(),
+        bnd_patch: s.patch.clone(),
+        ..Default::default()
+    };
+    write_mesh(out, &mesh, &write_options(w, Some(s))?)?;
+    println!("wrote the surface to {}", out.display());
+    Ok(())
 }
 
 fn run_check(path: &Path) -> Result<(), Fail> {

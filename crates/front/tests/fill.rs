@@ -90,7 +90,7 @@ fn fills_an_icosphere() {
 
 #[test]
 fn fills_a_torus() {
-    let s = generate::torus([0.0; 3], 2.0, 0.6, 48, 16);
-    let (m, st) = fill(&s, 0.25);
+    let s = generate::torus([0.0; 3], 2.0, 0.6, 32, 12);
+    let (m, st) = fill(&s, 0.3);
     eprintln!("torus: {} tets, {:?}", m.tets.len(), st);
 }

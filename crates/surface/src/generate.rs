@@ -207,7 +207,7 @@ pub fn voxels(
 }
 
 /// The built-in demo part: a block with a square hole drilled through it,
-/// a spherical void, and a torus-shaped inner body (its own region with
+/// a spherical void, and a spherical inner body (its own region with
 /// `--regions`). Units are millimetres; about `h` = 1 everywhere.
 pub fn demo_part() -> Surface {
     let (nx, ny, nz) = (16, 12, 6);
@@ -225,7 +225,7 @@ pub fn demo_part() -> Surface {
             .flipped()
             .with_patch(6, "void"),
     );
-    s.append(&torus([9.0, 8.5, 3.0], 2.0, 0.7, 36, 12).with_patch(7, "inner body"));
+    s.append(&icosphere([8.5, 8.5, 3.0], 1.8, 2).with_patch(7, "inner body"));
     s
 }
 
@@ -270,7 +270,7 @@ mod tests {
         assert!(edges_paired(&demo));
         let expect = (16.0 * 12.0 - 9.0) * 6.0;
         let v = demo.signed_volume();
-        // Block minus the void, plus the torus counted once more.
+        // Block minus the void, plus the inner body counted once more.
         assert!(v > expect - 20.0 && v < expect + 25.0, "{v}");
     }
 }

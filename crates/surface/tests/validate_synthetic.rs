@@ -506,17 +506,27 @@ fn inside_out_and_wrongly_oriented_void() {
     assert!((volume + 1.0).abs() < 1e-12);
     assert!(r.to_string().contains("inside-out"));
 
-    // A void with outward normals.
+    // A body with outward normals inside material is an embedded body.
     let s = merge(&[cube([0.0; 3], 4.0), cube([1.0; 3], 2.0)]);
+    let r = validate(&s);
+    assert!(r.is_valid(), "{r}");
+    assert_eq!(r.shells[1].kind, ShellKind::Inner);
+
+    // A cavity inside a cavity is inside-out.
+    let s = merge(&[
+        cube([0.0; 3], 4.0),
+        flip(cube([1.0; 3], 2.0)),
+        flip(cube([1.5; 3], 1.0)),
+    ]);
     let r = validate(&s);
     let p = r.problem(Class::WrongShellOrientation).unwrap();
     assert_eq!(p.count, 1);
     assert!(matches!(
         p.examples[0],
         Item::Shell {
-            shell: 1,
-            first_tri: 12,
-            depth: 1,
+            shell: 2,
+            first_tri: 24,
+            depth: 2,
             ..
         }
     ));

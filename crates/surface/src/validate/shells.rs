@@ -3,9 +3,10 @@
 //! Shell `i` is inside shell `j` when a vertex of `i` is inside `j`, decided
 //! by the parity of exact transversal crossings along a ray; a ray that
 //! grazes an edge, a vertex or a plane is dropped and another direction
-//! drawn. Depth = number of closed shells containing the shell; odd depth is
-//! a void (its triangles point into it: negative volume), even depth an
-//! outer shell or an inner body (positive volume).
+//! drawn. Depth = number of closed shells containing the shell. Inside
+//! material a shell with negative volume is a void (its triangles point into
+//! it) and one with positive volume an embedded body (a region of its own);
+//! inside a void only a body (positive) may float.
 use super::bvh::Bvh;
 use super::selfint::tri_boxes;
 use super::topology::Edges;
@@ -18,9 +19,9 @@ use rayon::prelude::*;
 pub enum ShellKind {
     /// Depth 0: bounds the domain from outside; must have positive volume.
     Outer,
-    /// Odd depth: a cavity; must have negative volume.
+    /// A cavity inside material: negative volume.
     Void,
-    /// Even depth > 0: a body inside a void; must have positive volume.
+    /// A body embedded in material or floating in a void: positive volume.
     Inner,
     /// Has an edge not used by exactly two triangles: nesting not computed.
     NotClosed,
@@ -221,18 +222,24 @@ fn nest(s: &Surface, out: &mut [Shell], boxes: &[Aabb]) {
         out[i as usize].depth = contains[k].len() as u32;
     }
     for (k, &i) in closed.iter().enumerate() {
-        let d = out[i as usize].depth;
-        let parent = contains[k]
+        out[i as usize].parent = contains[k]
             .iter()
             .copied()
             .max_by_key(|&j| out[j as usize].depth);
-        let sh = &mut out[i as usize];
-        sh.parent = parent;
-        sh.kind = match d {
-            0 => ShellKind::Outer,
-            d if d % 2 == 1 => ShellKind::Void,
-            _ => ShellKind::Inner,
+    }
+    // Outside in, so a parent's kind is known first. Inside material, a
+    // negative shell is a void and a positive one an embedded body (its
+    // own region: an interface); inside a void only a body can float.
+    let mut order: Vec<u32> = closed.clone();
+    order.sort_by_key(|&i| out[i as usize].depth);
+    for i in order {
+        let kind = match out[i as usize].parent {
+            None => ShellKind::Outer,
+            Some(p) if out[p as usize].kind == ShellKind::Void => ShellKind::Inner,
+            Some(_) if out[i as usize].volume < 0.0 => ShellKind::Void,
+            Some(_) => ShellKind::Inner,
         };
+        out[i as usize].kind = kind;
     }
 }
 

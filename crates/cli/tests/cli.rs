@@ -1,0 +1,168 @@
+//! The binary end to end: exit codes and what it writes.
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_parafront"))
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("parafront-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d.join(name)
+}
+
+fn corpus() -> Option<PathBuf> {
+    match std::env::var_os("PARAFRONT_GEOMETRY") {
+        Some(p) => Some(PathBuf::from(p)),
+        None => {
+            eprintln!("skipped: PARAFRONT_GEOMETRY is not set");
+            None
+        }
+    }
+}
+
+#[test]
+fn demo_surface_is_valid_and_written() {
+    let out = tmp("demo_surface.msh");
+    let o = bin()
+        .args(["demo", "--check-only", "-o"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{text}");
+    assert!(
+        text.contains("void") && text.contains("inner body"),
+        "{text}"
+    );
+    // Read back: the same triangles.
+    let m = parafront_io::read_mesh(&out).unwrap();
+    let s = parafront_surface::generate::demo_part();
+    assert_eq!(m.bnd_tris.len(), s.tris.len());
+    assert_eq!(m.points.len(), s.points.len());
+}
+
+#[test]
+fn check_rejects_an_open_surface_with_exit_1() {
+    let f = tmp("open.obj");
+    std::fs::write(
+        &f,
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 2 3 4\n",
+    )
+    .unwrap();
+    let o = bin().arg("check").arg(&f).output().unwrap();
+    assert_eq!(o.status.code(), Some(1));
+    let text = String::from_utf8_lossy(&o.stdout).to_lowercase();
+    assert!(text.contains("open"), "{text}");
+}
+
+#[test]
+fn unreadable_input_gives_exit_2_and_names_the_line() {
+    let f = tmp("bad.obj");
+    std::fs::write(&f, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n").unwrap();
+    let o = bin().arg("check").arg(&f).output().unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("bad.obj:4"), "{err}");
+}
+
+#[test]
+fn convert_round_trips_a_box_mesh_through_every_format() {
+    let m = parafront_mesh::generate::box_mesh(3, 2, 2, [0.0; 3], [1.0, 1.0, 1.0]);
+    let src = tmp("box.vtu");
+    parafront_io::write_mesh(&src, &m, &Default::default()).unwrap();
+    for (ext, extra) in [
+        ("msh", &[][..]),
+        ("msh", &["--msh-version", "2.2", "--binary"][..]),
+        ("mesh", &[][..]),
+    ] {
+        let dst = tmp(&format!("box_{}.{ext}", extra.len()));
+        let o = bin()
+            .arg("convert")
+            .arg(&src)
+            .arg(&dst)
+            .args(extra)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let back = parafront_io::read_mesh(&dst).unwrap();
+        assert_eq!(back.points, m.points);
+        assert_eq!(back.tets.len(), m.tets.len());
+        back.check().unwrap();
+    }
+    let o = bin().arg("quality").arg(&src).output().unwrap();
+    assert!(o.status.success());
+    assert!(String::from_utf8_lossy(&o.stdout).contains("dihedral"));
+}
+
+#[test]
+fn a_box_mesh_passes_meshcheck() {
+    let tool = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/tools/meshcheck.py");
+    let ok = Command::new("python3")
+        .args(["-c", "import numpy, meshio"])
+        .status()
+        .map(|s| s.success())
+        .unwrap_or(false);
+    if !tool.exists() || !ok {
+        eprintln!("skipped: meshcheck.py or python3 with numpy+meshio not available");
+        return;
+    }
+    let m = parafront_mesh::generate::box_mesh(4, 3, 2, [0.0; 3], [2.0, 1.5, 1.0]);
+    m.check_against_surface(
+        &m.bnd_tris
+            .iter()
+            .map(|t| t.map(|p| p.0))
+            .collect::<Vec<_>>(),
+    )
+    .unwrap();
+    let vol = tmp("meshcheck_box.vtu");
+    parafront_io::write_mesh(&vol, &m, &Default::default()).unwrap();
+    let surf = tmp("meshcheck_surface.msh");
+    let s = parafront_mesh::TetMesh {
+        points: m.points.clone(),
+        bnd_tris: m.bnd_tris.clone(),
+        bnd_patch: m.bnd_patch.clone(),
+        ..Default::default()
+    };
+    parafront_io::write_mesh(&surf, &s, &Default::default()).unwrap();
+    let o = Command::new("python3")
+        .arg(&tool)
+        .arg(&vol)
+        .arg("--surface")
+        .arg(&surf)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stdout));
+}
+
+#[test]
+fn check_corpus_exit_codes() {
+    let Some(g) = corpus() else { return };
+    for e in std::fs::read_dir(g.join("valid")).unwrap() {
+        let p = e.unwrap().path();
+        let o = bin().arg("check").arg(&p).output().unwrap();
+        assert!(
+            o.status.success(),
+            "{}: {}",
+            p.display(),
+            String::from_utf8_lossy(&o.stdout)
+        );
+    }
+    for (f, want) in [
+        ("stanford-bunny.obj", &["open"][..]),
+        ("cow.obj", &["pinched", "self-intersect"][..]),
+        ("wingnut.obj", &["self-intersect"][..]),
+    ] {
+        let o = bin()
+            .arg("check")
+            .arg(g.join("invalid").join(f))
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(1), "{f}");
+        let text = String::from_utf8_lossy(&o.stdout).to_lowercase();
+        for w in want {
+            assert!(text.contains(w), "{f}: expected '{w}' in\n{text}");
+        }
+    }
+}
