@@ -2,7 +2,6 @@
 //! broken variant per defect class, checking class, count and ids.
 use parafront_surface::validate::{regions, shells, validate, Class, Item, Region, ShellKind};
 use parafront_surface::Surface;
-use std::collections::HashMap;
 
 type P3 = [f64; 3];
 
@@ -54,69 +53,7 @@ fn cube(lo: P3, h: f64) -> Surface {
     surf(points, tris)
 }
 
-fn icosphere(c: P3, r: f64, level: u32) -> Surface {
-    let t = (1.0 + 5f64.sqrt()) / 2.0;
-    let mut pts: Vec<P3> = vec![
-        [-1.0, t, 0.0],
-        [1.0, t, 0.0],
-        [-1.0, -t, 0.0],
-        [1.0, -t, 0.0],
-        [0.0, -1.0, t],
-        [0.0, 1.0, t],
-        [0.0, -1.0, -t],
-        [0.0, 1.0, -t],
-        [t, 0.0, -1.0],
-        [t, 0.0, 1.0],
-        [-t, 0.0, -1.0],
-        [-t, 0.0, 1.0],
-    ];
-    let mut tris: Vec<[u32; 3]> = vec![
-        [0, 11, 5],
-        [0, 5, 1],
-        [0, 1, 7],
-        [0, 7, 10],
-        [0, 10, 11],
-        [1, 5, 9],
-        [5, 11, 4],
-        [11, 10, 2],
-        [10, 7, 6],
-        [7, 1, 8],
-        [3, 9, 4],
-        [3, 4, 2],
-        [3, 2, 6],
-        [3, 6, 8],
-        [3, 8, 9],
-        [4, 9, 5],
-        [2, 4, 11],
-        [6, 2, 10],
-        [8, 6, 7],
-        [9, 8, 1],
-    ];
-    for _ in 0..level {
-        let mut mid: HashMap<(u32, u32), u32> = HashMap::new();
-        let mut m = |a: u32, b: u32, pts: &mut Vec<P3>| {
-            *mid.entry((a.min(b), a.max(b))).or_insert_with(|| {
-                let (p, q) = (pts[a as usize], pts[b as usize]);
-                pts.push([0, 1, 2].map(|k| 0.5 * (p[k] + q[k])));
-                pts.len() as u32 - 1
-            })
-        };
-        let mut next = Vec::with_capacity(tris.len() * 4);
-        for &[a, b, c] in &tris {
-            let (ab, bc, ca) = (m(a, b, &mut pts), m(b, c, &mut pts), m(c, a, &mut pts));
-            next.extend([[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
-        }
-        tris = next;
-    }
-    let pts = pts
-        .iter()
-        .map(|p| {
-            let n = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
-            [0, 1, 2].map(|k| c[k] + r * p[k] / n)
-        })
-        .collect();
-    surf(pts, tris)
-}
+use parafront_surface::generate::icosphere;
 
 fn torus(rr: f64, r: f64, n: u32, m: u32) -> Surface {
     let mut pts = Vec::new();

@@ -1,83 +1,11 @@
 //! Test surfaces generated in code.
 #![allow(dead_code)]
 use parafront_surface::Surface;
-use std::collections::HashMap;
 
 /// Unit icosphere (outward triangles), `level` midpoint subdivisions.
+/// The shared generator, centred at the origin.
 pub fn icosphere(level: u32, radius: f64) -> Surface {
-    let t = (1.0 + 5f64.sqrt()) / 2.0;
-    let mut pts: Vec<[f64; 3]> = vec![
-        [-1.0, t, 0.0],
-        [1.0, t, 0.0],
-        [-1.0, -t, 0.0],
-        [1.0, -t, 0.0],
-        [0.0, -1.0, t],
-        [0.0, 1.0, t],
-        [0.0, -1.0, -t],
-        [0.0, 1.0, -t],
-        [t, 0.0, -1.0],
-        [t, 0.0, 1.0],
-        [-t, 0.0, -1.0],
-        [-t, 0.0, 1.0],
-    ];
-    let mut tris: Vec<[u32; 3]> = vec![
-        [0, 11, 5],
-        [0, 5, 1],
-        [0, 1, 7],
-        [0, 7, 10],
-        [0, 10, 11],
-        [1, 5, 9],
-        [5, 11, 4],
-        [11, 10, 2],
-        [10, 7, 6],
-        [7, 1, 8],
-        [3, 9, 4],
-        [3, 4, 2],
-        [3, 2, 6],
-        [3, 6, 8],
-        [3, 8, 9],
-        [4, 9, 5],
-        [2, 4, 11],
-        [6, 2, 10],
-        [8, 6, 7],
-        [9, 8, 1],
-    ];
-    for _ in 0..level {
-        let mut mid: HashMap<(u32, u32), u32> = HashMap::new();
-        let mut next = Vec::with_capacity(tris.len() * 4);
-        for tri in &tris {
-            let mut m = [0u32; 3];
-            for k in 0..3 {
-                let (a, b) = (tri[k], tri[(k + 1) % 3]);
-                let key = (a.min(b), a.max(b));
-                m[k] = *mid.entry(key).or_insert_with(|| {
-                    let (pa, pb) = (pts[a as usize], pts[b as usize]);
-                    pts.push([
-                        (pa[0] + pb[0]) / 2.0,
-                        (pa[1] + pb[1]) / 2.0,
-                        (pa[2] + pb[2]) / 2.0,
-                    ]);
-                    (pts.len() - 1) as u32
-                });
-            }
-            next.push([tri[0], m[0], m[2]]);
-            next.push([tri[1], m[1], m[0]]);
-            next.push([tri[2], m[2], m[1]]);
-            next.push([m[0], m[1], m[2]]);
-        }
-        tris = next;
-    }
-    for p in &mut pts {
-        let n = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
-        *p = [p[0] / n * radius, p[1] / n * radius, p[2] / n * radius];
-    }
-    let patch = vec![0; tris.len()];
-    Surface {
-        points: pts,
-        tris,
-        patch,
-        patch_names: vec![],
-    }
+    parafront_surface::generate::icosphere([0.0; 3], radius, level)
 }
 
 /// Torus (major radius `r1`, minor `r2`) with `nu x nv` points; patch 1 on
