@@ -4,30 +4,10 @@ use parafront_geom::*;
 use parafront_mesh::{PointId, TetMesh};
 use parafront_surface::{generate, Surface};
 
-/// Mean incident edge length per point (AG3 without a size field).
-fn point_sizes(s: &Surface) -> Vec<f64> {
-    let mut sum = vec![0.0; s.points.len()];
-    let mut cnt = vec![0.0; s.points.len()];
-    for t in &s.tris {
-        for k in 0..3 {
-            let (a, b) = (t[k] as usize, t[(k + 1) % 3] as usize);
-            let l = dist(s.points[a], s.points[b]);
-            sum[a] += l;
-            sum[b] += l;
-            cnt[a] += 1.0;
-            cnt[b] += 1.0;
-        }
-    }
-    sum.iter()
-        .zip(&cnt)
-        .map(|(s, c)| if *c > 0.0 { s / c } else { 1.0 })
-        .collect()
-}
-
 fn fill(s: &Surface, h: f64) -> (TetMesh, FrontStats) {
     let input = FrontInput {
         points: s.points.clone(),
-        point_size: point_sizes(s),
+        point_size: s.mean_edge_lengths(),
         faces: s.tris.iter().map(|t| [t[0], t[2], t[1]]).collect(),
     };
     let field = move |_p: P3| h;

@@ -8,22 +8,6 @@ use parafront_surface::Surface;
 use proptest::prelude::*;
 use std::collections::BTreeMap;
 
-fn mean_edge_lengths(s: &Surface) -> Vec<f64> {
-    let mut sum = vec![0.0; s.points.len()];
-    let mut n = vec![0.0; s.points.len()];
-    for t in &s.tris {
-        for k in 0..3 {
-            let (a, b) = (t[k] as usize, t[(k + 1) % 3] as usize);
-            let l = dist(s.points[a], s.points[b]);
-            sum[a] += l;
-            sum[b] += l;
-            n[a] += 1.0;
-            n[b] += 1.0;
-        }
-    }
-    sum.iter().zip(&n).map(|(s, n)| s / n).collect()
-}
-
 fn exact(seeds: &[([f64; 3], f64)], c: f64, p: [f64; 3]) -> f64 {
     seeds
         .iter()
@@ -109,7 +93,7 @@ fn icosphere_growth_matches_edges_and_exact_formula() {
     let s = icosphere(4, 1.0); // 2562 points
     let o = SizeOptions::default();
     let sz = Sizing::build(&s, &o, None).unwrap();
-    let mean = mean_edge_lengths(&s);
+    let mean = s.mean_edge_lengths();
     let seeds: Vec<_> = s.points.iter().cloned().zip(mean.iter().cloned()).collect();
     let c = o.gradation - 1.0;
     let ps = sz.surface_point_sizes();
@@ -209,7 +193,7 @@ proptest! {
 fn patch_sizes_refine_their_points() {
     // Torus: patch 1 = outer half. Its points get 0.01; patch 0 keeps edges.
     let s = torus(60, 24, 1.0, 0.3);
-    let mean = mean_edge_lengths(&s);
+    let mean = s.mean_edge_lengths();
     let mut ps = BTreeMap::new();
     ps.insert("1".to_string(), 0.01);
     ps.insert("0".to_string(), 10.0); // larger than the edges: no effect
@@ -468,7 +452,8 @@ fn no_growth_is_the_smallest_surface_size() {
         ..Default::default()
     };
     let sz = Sizing::build(&s, &o, None).unwrap();
-    let hmin = mean_edge_lengths(&s)
+    let hmin = s
+        .mean_edge_lengths()
         .into_iter()
         .fold(f64::INFINITY, f64::min);
     assert!((sz.size([0.0; 3]) - hmin).abs() < 1e-12);
