@@ -12,6 +12,12 @@ use rustc_hash::FxHashMap;
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
 
+mod cavity;
+
+/// Smallest mean ratio the front accepts: a flatter tet may be positive
+/// only in exact arithmetic, and a solver reads it as inverted.
+const SHAPE_FLOOR: f64 = 2e-3;
+
 const NONE: u32 = u32::MAX;
 
 /// Tuning of the front. The defaults are what the serial mesher uses.
@@ -31,7 +37,7 @@ impl Default for FrontOptions {
     fn default() -> Self {
         FrontOptions {
             tries_per_face: 3,
-            recovery_rounds: 40,
+            recovery_rounds: 12,
             max_points: u32::MAX as usize - 1,
             progress_every: 0,
         }
@@ -54,6 +60,8 @@ pub struct FrontStats {
     pub retries: usize,
     pub recovery_rounds: u32,
     pub tets_removed: usize,
+    /// Pockets closed by coning to an inner point (recovery's last resort).
+    pub pockets_filled: usize,
 }
 
 /// What the front made.
@@ -376,6 +384,21 @@ impl<'a> Front<'a> {
     fn recover(&mut self) {
         self.relax += 1;
         self.stats.recovery_rounds = self.relax;
+        if self.relax >= 2 {
+            // Step 5.3 before more removal: cone the pockets that allow it.
+            self.fill_pockets();
+            // Growth may have replaced stuck faces by new ones.
+            let mut held = vec![false; self.fv.len()];
+            for &f in &self.prohibited {
+                held[f as usize] = true;
+            }
+            self.stuck = (0..self.fv.len() as u32)
+                .filter(|&f| self.falive[f as usize] && !held[f as usize])
+                .collect();
+            if self.stuck.is_empty() {
+                return;
+            }
+        }
         let layers = 1 + (self.relax as usize - 1) / 2;
         let mut mark = vec![false; self.pts.len()];
         for &f in &self.stuck {
@@ -524,7 +547,7 @@ impl<'a> Front<'a> {
                 continue;
             }
             let (shape, mut score) = candidate_score(pa, pb, pc, pq, h);
-            if shape <= 0.0 {
+            if shape <= SHAPE_FLOOR {
                 continue;
             }
             if dist2(pq, pstar) < too_close * too_close {
@@ -552,8 +575,10 @@ impl<'a> Front<'a> {
                     .all(|&q| v.contains(&q) || dist2(self.pts[q as usize], p) >= lim * lim)
             };
             if clear && self.region.point_ok(p) {
-                let (_, score) = candidate_score(pa, pb, pc, p, h);
-                cands.push((score * (1.0 - 0.1 * k as f64), NONE - k as u32));
+                let (shape, score) = candidate_score(pa, pb, pc, p, h);
+                if shape > SHAPE_FLOOR {
+                    cands.push((score * (1.0 - 0.1 * k as f64), NONE - k as u32));
+                }
             }
         }
         cands.sort_unstable_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));

@@ -1,0 +1,256 @@
+//! Recovery's last resort (issue 3, step 5.3): a pocket of stuck faces is
+//! grown, by removing the tet behind each face it sees badly, until one
+//! inner point sees every face well; the pocket is then filled by coning
+//! its faces to that point. A closed pocket whose every face sees the point
+//! on its inner side is star-shaped about it, so the cones tile it; each
+//! cone is still checked exactly against the rest of the front.
+use super::*;
+use crate::quality::mean_ratio;
+
+/// Smallest mean ratio of a cone tet: far from flat in floating point.
+const CONE_FLOOR: f64 = 2e-3;
+/// Pockets larger than this are not coned (the cone would be poor and the
+/// search slow); recovery removes layers instead.
+const MAX_POCKET: usize = 3000;
+const MAX_GROWTH: usize = 40;
+
+enum Pocket {
+    Filled,
+    Failed,
+}
+
+impl<'a> Front<'a> {
+    /// Fill every pocket of the front that holds no prohibited face.
+    /// Returns the number of pockets left unfilled.
+    pub(super) fn fill_pockets(&mut self) -> usize {
+        let mut failed = 0;
+        let mut skip = vec![false; self.fv.len()];
+        let mut seed = 0usize;
+        while seed < self.fv.len() {
+            if seed >= skip.len() {
+                skip.resize(self.fv.len(), false);
+            }
+            if !self.falive[seed] || skip[seed] {
+                seed += 1;
+                continue;
+            }
+            if let Pocket::Failed = self.fill_pocket(seed as u32) {
+                failed += 1;
+                skip.resize(self.fv.len(), false);
+                // Do not try the faces of this pocket again in this round.
+                for f in self.pocket(seed as u32) {
+                    skip[f as usize] = true;
+                }
+            }
+            seed += 1;
+        }
+        failed
+    }
+
+    /// The faces reachable from `seed` over shared edges.
+    fn pocket(&self, seed: u32) -> Vec<u32> {
+        let mut out = vec![seed];
+        let mut seen = FxHashMap::default();
+        seen.insert(seed, ());
+        let mut i = 0;
+        while i < out.len() && out.len() <= MAX_POCKET {
+            let f = out[i];
+            i += 1;
+            let v = self.fv[f as usize];
+            let bb = tri_box(&self.pts, v);
+            self.fgrid.query(&bb, |g| {
+                if seen.contains_key(&g) || !self.falive[g as usize] {
+                    return;
+                }
+                let w = self.fv[g as usize];
+                if w.iter().filter(|x| v.contains(x)).count() >= 2 {
+                    seen.insert(g, ());
+                    out.push(g);
+                }
+            });
+        }
+        out.sort_unstable();
+        out
+    }
+
+    fn fill_pocket(&mut self, seed: u32) -> Pocket {
+        let mut seed = seed;
+        for _ in 0..MAX_GROWTH {
+            let pocket = self.pocket(seed);
+            if pocket.len() > MAX_POCKET || pocket.iter().any(|&f| self.prohibited_face(f)) {
+                return Pocket::Failed;
+            }
+            let p = self.kernel_point(&pocket);
+            let bad: Vec<u32> = pocket
+                .iter()
+                .copied()
+                .filter(|&f| self.cone_shape(f, p) < CONE_FLOOR)
+                .collect();
+            if bad.is_empty() {
+                return if self.region.point_ok(p) && self.cone_is_free(&pocket, p) {
+                    self.commit_cone(&pocket, p);
+                    Pocket::Filled
+                } else {
+                    Pocket::Failed
+                };
+            }
+            // Grow: the tets behind the badly seen faces leave.
+            let mut dead: Vec<u32> = bad
+                .iter()
+                .map(|&f| self.fowner[f as usize])
+                .filter(|&o| o != NONE)
+                .map(|o| o >> 2)
+                .collect();
+            dead.sort_unstable();
+            dead.dedup();
+            if dead.is_empty() {
+                return Pocket::Failed; // only input faces are seen badly
+            }
+            let before = self.fv.len();
+            for &t in &dead {
+                self.talive[t as usize] = false;
+            }
+            for &t in &dead {
+                self.unlink_tet(t);
+            }
+            self.stats.tets_removed += dead.len();
+            let next = pocket
+                .iter()
+                .copied()
+                .chain(before as u32..self.fv.len() as u32)
+                .find(|&f| self.falive[f as usize]);
+            match next {
+                Some(f) => seed = f,
+                None => return Pocket::Failed,
+            }
+        }
+        Pocket::Failed
+    }
+
+    fn prohibited_face(&self, f: u32) -> bool {
+        let v = self.fv[f as usize];
+        v.iter()
+            .any(|&p| !self.region.point_ok(self.pts[p as usize]))
+    }
+
+    #[inline]
+    fn cone_shape(&self, f: u32, p: P3) -> f64 {
+        let v = self.fv[f as usize];
+        mean_ratio(
+            self.pts[v[0] as usize],
+            self.pts[v[1] as usize],
+            self.pts[v[2] as usize],
+            p,
+        )
+    }
+
+    fn worst_cone(&self, pocket: &[u32], p: P3) -> f64 {
+        let mut w = f64::INFINITY;
+        for &f in pocket {
+            w = w.min(self.cone_shape(f, p));
+            if w < -1.0 {
+                break;
+            }
+        }
+        w
+    }
+
+    /// A point that sees every pocket face as well as it can: the best of
+    /// a few inward offsets and the vertex centroid, then a pattern search.
+    fn kernel_point(&self, pocket: &[u32]) -> P3 {
+        let mut cands = Vec::new();
+        let mut c = [0.0; 3];
+        let mut hsum = 0.0;
+        for &f in pocket {
+            let v = self.fv[f as usize];
+            let [a, b, d] = v.map(|i| self.pts[i as usize]);
+            let m = centroid3(a, b, d);
+            c = add(c, m);
+            hsum += (dist(a, b) + dist(b, d) + dist(d, a)) / 3.0;
+        }
+        let n = pocket.len() as f64;
+        c = scale(c, 1.0 / n);
+        let hmean = hsum / n;
+        cands.push(c);
+        let stride = (pocket.len() / 48).max(1);
+        for &f in pocket.iter().step_by(stride) {
+            let v = self.fv[f as usize];
+            let [a, b, d] = v.map(|i| self.pts[i as usize]);
+            let m = centroid3(a, b, d);
+            let nrm = normalize(tri_normal(a, b, d));
+            for k in [0.25, 0.5, 0.8] {
+                cands.push(add(m, scale(nrm, k * hmean)));
+            }
+        }
+        let mut best = c;
+        let mut bw = f64::NEG_INFINITY;
+        for q in cands {
+            let w = self.worst_cone(pocket, q);
+            if w > bw {
+                bw = w;
+                best = q;
+            }
+        }
+        // Pattern search on the worst cone.
+        let mut step = 0.25 * hmean;
+        for _ in 0..48 {
+            let mut moved = false;
+            for k in 0..6 {
+                let mut q = best;
+                q[k / 2] += if k % 2 == 0 { step } else { -step };
+                let w = self.worst_cone(pocket, q);
+                if w > bw {
+                    bw = w;
+                    best = q;
+                    moved = true;
+                }
+            }
+            if !moved {
+                step *= 0.5;
+                if step < 1e-3 * hmean {
+                    break;
+                }
+            }
+        }
+        best
+    }
+
+    /// Every cone tet crosses no other front face and holds no front point.
+    fn cone_is_free(&self, pocket: &[u32], p: P3) -> bool {
+        let mut bb = Aabb { min: p, max: p };
+        for &f in pocket {
+            bb = bb.union(&tri_box(&self.pts, self.fv[f as usize]));
+        }
+        let mut near_f = Vec::new();
+        let mut near_p = Vec::new();
+        self.pgrid.query(&bb, |q| near_p.push(q));
+        self.fgrid.query(&bb, |g| {
+            near_f.push(Near {
+                id: g,
+                v: self.fv[g as usize],
+                bb: tri_box(&self.pts, self.fv[g as usize]),
+            })
+        });
+        for &f in pocket {
+            let v = self.fv[f as usize];
+            let [a, b, c] = v.map(|i| self.pts[i as usize]);
+            if orient3d(a, b, c, p) <= 0.0 {
+                return false;
+            }
+            let others: Vec<Near> = near_f.iter().copied().filter(|n| n.id != f).collect();
+            if !self.tet_is_free(v, NONE, p, &others, &near_p) {
+                return false;
+            }
+        }
+        true
+    }
+
+    fn commit_cone(&mut self, pocket: &[u32], p: P3) {
+        let id = self.pts.len() as u32;
+        self.commit(pocket[0], NONE, p);
+        for &f in &pocket[1..] {
+            self.commit(f, id, p);
+        }
+        self.stats.pockets_filled += 1;
+    }
+}
