@@ -11,7 +11,8 @@ pub fn mean_ratio(a: P3, b: P3, c: P3, d: P3) -> f64 {
         return 0.0;
     }
     let v3 = 0.5 * v6; // 3V
-    12.0 * v3.signum() * v3.abs().powf(2.0 / 3.0) / s
+    let c = v3.cbrt();
+    12.0 * v3.signum() * c * c / s
 }
 
 /// Mean ratio of `abcq` damped by how far its new edges stray from `h`.

@@ -11,22 +11,27 @@ use crate::quality::mean_ratio;
 const CONE_FLOOR: f64 = 2e-3;
 /// Pockets larger than this are not coned (the cone would be poor and the
 /// search slow); recovery removes layers instead.
-const MAX_POCKET: usize = 3000;
-const MAX_GROWTH: usize = 40;
+const MAX_POCKET: usize = 400;
+const MAX_GROWTH: usize = 24;
 
 enum Pocket {
     Filled,
+    /// Part of it coned; the front goes on from the new faces.
+    Partial,
     Failed,
 }
 
 impl<'a> Front<'a> {
     /// Fill every pocket of the front that holds no prohibited face.
     /// Returns the number of pockets left unfilled.
-    pub(super) fn fill_pockets(&mut self) -> usize {
+    pub(super) fn fill_pockets(&mut self) -> (usize, usize) {
         let mut failed = 0;
+        let mut progress = 0;
         let mut skip = vec![false; self.fv.len()];
         let mut seed = 0usize;
-        while seed < self.fv.len() {
+        // Faces made here wait for the next round.
+        let end = self.fv.len();
+        while seed < end {
             if seed >= skip.len() {
                 skip.resize(self.fv.len(), false);
             }
@@ -34,7 +39,11 @@ impl<'a> Front<'a> {
                 seed += 1;
                 continue;
             }
-            if let Pocket::Failed = self.fill_pocket(seed as u32) {
+            let r = self.fill_pocket(seed as u32);
+            if !matches!(r, Pocket::Failed) {
+                progress += 1;
+            }
+            if !matches!(r, Pocket::Filled) {
                 failed += 1;
                 skip.resize(self.fv.len(), false);
                 // Do not try the faces of this pocket again in this round.
@@ -44,7 +53,7 @@ impl<'a> Front<'a> {
             }
             seed += 1;
         }
-        failed
+        (progress, failed)
     }
 
     /// The faces reachable from `seed` over shared edges.
@@ -75,7 +84,7 @@ impl<'a> Front<'a> {
 
     fn fill_pocket(&mut self, seed: u32) -> Pocket {
         let mut seed = seed;
-        for _ in 0..MAX_GROWTH {
+        for round in 0..MAX_GROWTH {
             let pocket = self.pocket(seed);
             if pocket.len() > MAX_POCKET || pocket.iter().any(|&f| self.prohibited_face(f)) {
                 return Pocket::Failed;
@@ -103,8 +112,10 @@ impl<'a> Front<'a> {
                 .collect();
             dead.sort_unstable();
             dead.dedup();
-            if dead.is_empty() {
-                return Pocket::Failed; // only input faces are seen badly
+            if dead.is_empty() || round + 1 == MAX_GROWTH {
+                // Only input faces are seen badly, or growth is not
+                // converging: cone what the point sees well.
+                return self.partial_cone(&pocket, p);
             }
             let before = self.fv.len();
             for &t in &dead {
@@ -125,6 +136,54 @@ impl<'a> Front<'a> {
             }
         }
         Pocket::Failed
+    }
+
+    /// Cone the faces `p` sees well and whose cones are free. Those cones
+    /// cannot overlap: a face inside another's cone would cross it.
+    fn partial_cone(&mut self, pocket: &[u32], p: P3) -> Pocket {
+        if !self.region.point_ok(p) {
+            return Pocket::Failed;
+        }
+        // A new point on top of an old one would make slivers later.
+        let hmean = pocket
+            .iter()
+            .map(|&f| {
+                let v = self.fv[f as usize].map(|i| self.pts[i as usize]);
+                (dist(v[0], v[1]) + dist(v[1], v[2]) + dist(v[2], v[0])) / 3.0
+            })
+            .sum::<f64>()
+            / pocket.len() as f64;
+        let mut crowded = false;
+        self.pgrid
+            .query(&Aabb { min: p, max: p }.inflated(0.2 * hmean), |q| {
+                crowded |= dist2(self.pts[q as usize], p) < 0.04 * hmean * hmean
+            });
+        if crowded {
+            return Pocket::Failed;
+        }
+        let mut take = Vec::new();
+        for &f in pocket {
+            if self.cone_shape(f, p) < 10.0 * CONE_FLOOR {
+                continue;
+            }
+            let cl = Clearance {
+                point: 0.02 * hmean,
+                wedge: 0.05,
+            };
+            if self.cone_free(f, p, cl) {
+                take.push(f);
+            }
+        }
+        if take.is_empty() {
+            return Pocket::Failed;
+        }
+        let id = self.pts.len() as u32;
+        self.commit(take[0], NONE, p);
+        for &f in &take[1..] {
+            self.commit(f, id, p);
+        }
+        self.stats.pockets_filled += 1;
+        Pocket::Partial
     }
 
     fn prohibited_face(&self, f: u32) -> bool {
@@ -217,32 +276,35 @@ impl<'a> Front<'a> {
 
     /// Every cone tet crosses no other front face and holds no front point.
     fn cone_is_free(&self, pocket: &[u32], p: P3) -> bool {
-        let mut bb = Aabb { min: p, max: p };
-        for &f in pocket {
-            bb = bb.union(&tri_box(&self.pts, self.fv[f as usize]));
+        pocket
+            .iter()
+            .all(|&f| self.cone_free(f, p, Clearance::EXACT))
+    }
+
+    /// The tet on face `f` with apex `p` is free, checked against the front
+    /// around it alone.
+    fn cone_free(&self, f: u32, p: P3, cl: Clearance) -> bool {
+        let v = self.fv[f as usize];
+        let [a, b, c] = v.map(|i| self.pts[i as usize]);
+        if orient3d(a, b, c, p) <= 0.0 {
+            return false;
         }
+        let bb = tri_box(&self.pts, v)
+            .union(&Aabb { min: p, max: p })
+            .inflated(cl.point);
         let mut near_f = Vec::new();
         let mut near_p = Vec::new();
         self.pgrid.query(&bb, |q| near_p.push(q));
         self.fgrid.query(&bb, |g| {
-            near_f.push(Near {
-                id: g,
-                v: self.fv[g as usize],
-                bb: tri_box(&self.pts, self.fv[g as usize]),
-            })
+            if g != f {
+                near_f.push(Near {
+                    id: g,
+                    v: self.fv[g as usize],
+                    bb: tri_box(&self.pts, self.fv[g as usize]),
+                })
+            }
         });
-        for &f in pocket {
-            let v = self.fv[f as usize];
-            let [a, b, c] = v.map(|i| self.pts[i as usize]);
-            if orient3d(a, b, c, p) <= 0.0 {
-                return false;
-            }
-            let others: Vec<Near> = near_f.iter().copied().filter(|n| n.id != f).collect();
-            if !self.tet_is_free(v, NONE, p, &others, &near_p) {
-                return false;
-            }
-        }
-        true
+        self.tet_is_free(v, NONE, p, &near_f, &near_p, cl)
     }
 
     fn commit_cone(&mut self, pocket: &[u32], p: P3) {

@@ -37,7 +37,7 @@ impl Default for FrontOptions {
     fn default() -> Self {
         FrontOptions {
             tries_per_face: 3,
-            recovery_rounds: 12,
+            recovery_rounds: 30,
             max_points: u32::MAX as usize - 1,
             progress_every: 0,
         }
@@ -181,6 +181,119 @@ fn shared_first(a: [u32; 3], ap: [P3; 3], b: [u32; 3], bp: [P3; 3]) -> ([P3; 3],
         }
     }
     (oa.map(|i| ap[i]), ob.map(|j| bp[j]))
+}
+
+/// How far a new tet keeps from the rest of the front: front points stay
+/// `point` away from it, and a new face and a front face on one edge leave
+/// a free wedge of at least `wedge` radians. Either gap could otherwise be
+/// closed only by a flat tet.
+#[derive(Clone, Copy)]
+struct Clearance {
+    point: f64,
+    wedge: f64,
+}
+
+impl Clearance {
+    fn for_round(tries: u32, h: f64) -> Clearance {
+        match tries {
+            0 => Clearance {
+                point: 0.05 * h,
+                wedge: 0.05,
+            },
+            1 | 2 => Clearance {
+                point: 0.03 * h,
+                wedge: 0.03,
+            },
+            _ => Clearance {
+                point: 0.015 * h,
+                wedge: 0.02,
+            },
+        }
+    }
+
+    /// Validity only: for cones that must close a pocket.
+    const EXACT: Clearance = Clearance {
+        point: 0.0,
+        wedge: 0.0,
+    };
+}
+
+/// New face `f` and front face `g` share an edge and lie within `min`
+/// radians of one plane (both normals point into free space).
+fn thin_wedge(f: [u32; 3], fp: [P3; 3], g: [u32; 3], gp: [P3; 3], min: f64) -> bool {
+    // The vertex of each off the shared edge.
+    let Some(i) = (0..3).find(|&i| !g.contains(&f[i])) else {
+        return false;
+    };
+    let Some(j) = (0..3).find(|&j| !f.contains(&g[j])) else {
+        return false;
+    };
+    let a = fp[(i + 1) % 3];
+    let e = normalize(sub(fp[(i + 2) % 3], a));
+    let perp = |x: P3| {
+        let d = sub(x, a);
+        normalize(sub(d, scale(e, dot(d, e))))
+    };
+    let u = perp(fp[i]);
+    let w = perp(gp[j]);
+    let n = normalize(tri_normal(fp[0], fp[1], fp[2]));
+    let psi = dot(w, n).atan2(dot(w, u));
+    // On the tet's side, a tiny angle means two near-coplanar faces whose
+    // crossing the exact test may see as a miss by rounding (a flat quad
+    // cut by both diagonals).
+    psi.abs() < min
+}
+
+/// The four face planes of a tet, for a float filter ahead of the exact
+/// tests: a triangle strictly outside one plane, by more than the rounding
+/// error, cannot meet the tet.
+struct SeparatingPlanes {
+    o: [P3; 4],
+    n: [P3; 4],
+    nn: [f64; 4],
+    inv_len: [f64; 4],
+}
+
+impl SeparatingPlanes {
+    #[inline]
+    fn new(tp: &[P3; 4]) -> SeparatingPlanes {
+        let mut o = [[0.0; 3]; 4];
+        let mut n = [[0.0; 3]; 4];
+        let mut nn = [0.0; 4];
+        let mut inv_len = [0.0; 4];
+        for (i, f) in TET_FACES.iter().enumerate() {
+            let (a, b, c) = (tp[f[0]], tp[f[1]], tp[f[2]]);
+            // Outward for a positive tet in parafront's convention.
+            let v = cross(sub(b, a), sub(c, a));
+            o[i] = a;
+            n[i] = v;
+            nn[i] = v[0].abs() + v[1].abs() + v[2].abs();
+            inv_len[i] = 1.0 / norm(v).max(1e-300);
+        }
+        SeparatingPlanes { o, n, nn, inv_len }
+    }
+
+    /// `x` is inside the tet grown by `margin` on every face.
+    #[inline]
+    fn within(&self, x: P3, margin: f64) -> bool {
+        (0..4).all(|i| dot(self.n[i], sub(x, self.o[i])) * self.inv_len[i] < margin)
+    }
+
+    #[inline]
+    fn separates(&self, g: &[P3; 3]) -> bool {
+        'planes: for i in 0..4 {
+            for x in g {
+                let d = sub(*x, self.o[i]);
+                let s = dot(self.n[i], d);
+                let err = 1e-12 * self.nn[i] * (d[0].abs() + d[1].abs() + d[2].abs());
+                if s <= err {
+                    continue 'planes;
+                }
+            }
+            return true;
+        }
+        false
+    }
 }
 
 fn tri_box(p: &[P3], v: [u32; 3]) -> Aabb {
@@ -382,11 +495,17 @@ impl<'a> Front<'a> {
     /// Recovery: remove the tets around the stuck faces, one growing layer
     /// per round, then re-mesh the hole with relaxed acceptance.
     fn recover(&mut self) {
+        tracing::debug!(
+            round = self.relax,
+            stuck = self.stuck.len(),
+            tets = self.stats.tets,
+            "front stuck: recovery"
+        );
         self.relax += 1;
         self.stats.recovery_rounds = self.relax;
         if self.relax >= 2 {
             // Step 5.3 before more removal: cone the pockets that allow it.
-            self.fill_pockets();
+            let (progress, _) = self.fill_pockets();
             // Growth may have replaced stuck faces by new ones.
             let mut held = vec![false; self.fv.len()];
             for &f in &self.prohibited {
@@ -398,8 +517,13 @@ impl<'a> Front<'a> {
             if self.stuck.is_empty() {
                 return;
             }
+            if progress > 0 && self.relax % 3 != 0 {
+                // Partial cones made new faces: the front goes on from them.
+                self.requeue_front();
+                return;
+            }
         }
-        let layers = 1 + (self.relax as usize - 1) / 2;
+        let layers = 1;
         let mut mark = vec![false; self.pts.len()];
         for &f in &self.stuck {
             for &p in &self.fv[f as usize] {
@@ -428,7 +552,11 @@ impl<'a> Front<'a> {
             self.unlink_tet(t);
         }
         self.stats.tets_removed += removed.len();
-        // Every face of the front gets another go, relaxed.
+        self.requeue_front();
+    }
+
+    /// Every face of the front gets another go, relaxed.
+    fn requeue_front(&mut self) {
         self.stuck.clear();
         for id in 0..self.fv.len() {
             if self.falive[id] {
@@ -527,9 +655,8 @@ impl<'a> Front<'a> {
                 })
             }
         });
-        // Sort for a deterministic order whatever the grid's layout.
-        near_p.sort_unstable();
-        near_f.sort_unstable_by_key(|n| n.id);
+        // The grid's layout follows from the order of operations alone, so
+        // the query order is deterministic without sorting.
         let mut star_clear = true;
         let too_close = 0.55 * h;
         for &q in &near_p {
@@ -588,11 +715,13 @@ impl<'a> Front<'a> {
             2 => 0.01,
             _ => 0.0,
         };
+        // Kept clear of other front points (a fraction of the size).
+        let cl = Clearance::for_round(self.relax + self.ftries[fid as usize] as u32, h);
         let mut placed = None;
         for &(score, q) in &cands {
             let s = if score >= 1.0 { score - 1.0 } else { score };
             if s < min_score {
-                break;
+                continue;
             }
             let pq = if q >= NONE - 3 {
                 add(
@@ -602,7 +731,7 @@ impl<'a> Front<'a> {
             } else {
                 self.pts[q as usize]
             };
-            if self.tet_is_free(v, q, pq, &near_f, &near_p) {
+            if self.tet_is_free(v, q, pq, &near_f, &near_p, cl) {
                 placed = Some((q, pq));
                 break;
             }
@@ -620,7 +749,16 @@ impl<'a> Front<'a> {
     }
 
     /// AF2.3: tet `v + q` must cross no front face and hold no front point.
-    fn tet_is_free(&self, v: [u32; 3], q: u32, pq: P3, near_f: &[Near], near_p: &[u32]) -> bool {
+    fn tet_is_free(
+        &self,
+        v: [u32; 3],
+        q: u32,
+        pq: P3,
+        near_f: &[Near],
+        near_p: &[u32],
+        cl: Clearance,
+    ) -> bool {
+        let margin = cl.point;
         let tv = [v[0], v[1], v[2], q];
         let tp = [
             self.pts[v[0] as usize],
@@ -633,12 +771,16 @@ impl<'a> Front<'a> {
             tb.grow(p);
         }
         let new_faces: [[usize; 3]; 3] = [TET_FACES[0], TET_FACES[1], TET_FACES[2]];
+        let planes = SeparatingPlanes::new(&tp);
         for nf in near_f {
             if !nf.bb.overlaps(&tb) {
                 continue;
             }
             let g = nf.v;
             let gp = g.map(|i| self.pts[i as usize]);
+            if planes.separates(&gp) {
+                continue;
+            }
             for lf in &new_faces {
                 let fvid = lf.map(|k| tv[k]);
                 let shared = fvid.iter().filter(|x| g.contains(x)).count();
@@ -649,21 +791,34 @@ impl<'a> Front<'a> {
                     }
                     continue;
                 }
+                if shared == 2
+                    && cl.wedge > 0.0
+                    && thin_wedge(fvid, lf.map(|k| tp[k]), g, gp, cl.wedge)
+                {
+                    return false;
+                }
                 let (fp, gq) = shared_first(fvid, lf.map(|k| tp[k]), g, gp);
                 if triangles_intersect(fp, gq, shared) {
                     return false;
                 }
             }
         }
+        // A front point inside the tet, or closer to it than `margin`,
+        // would leave a gap only a flat tet could close.
+        let tbm = tb.inflated(margin);
         for &p in near_p {
             if tv.contains(&p) {
                 continue;
             }
             let x = self.pts[p as usize];
-            if !tb.contains(x) {
+            if !tbm.contains(x) {
                 continue;
             }
-            if orient3d(tp[1], tp[2], tp[3], x) < 0.0
+            if margin > 0.0 {
+                if planes.within(x, margin) {
+                    return false;
+                }
+            } else if orient3d(tp[1], tp[2], tp[3], x) < 0.0
                 && orient3d(tp[0], tp[3], tp[2], x) < 0.0
                 && orient3d(tp[0], tp[1], tp[3], x) < 0.0
                 && orient3d(tp[0], tp[2], tp[1], x) < 0.0
