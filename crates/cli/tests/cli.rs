@@ -166,3 +166,54 @@ fn check_corpus_exit_codes() {
         }
     }
 }
+
+/// The README's first command, end to end: the demo part (a hole, a void
+/// and an embedded body) is meshed, and meshcheck agrees that the mesh keeps
+/// the surface and fills it exactly.
+#[test]
+fn demo_mesh_passes_meshcheck() {
+    let vol = tmp("demo_volume.vtu");
+    let o = bin().args(["demo", "-o"]).arg(&vol).output().unwrap();
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        o.status.success(),
+        "{text}{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let m = parafront_io::read_mesh(&vol).unwrap();
+    let s = parafront_surface::generate::demo_part();
+    assert!(m.tets.len() > 5000, "{} tets", m.tets.len());
+    // Two regions: the block and the embedded sphere.
+    let mut regions = m.region.clone();
+    regions.sort_unstable();
+    regions.dedup();
+    assert_eq!(regions.len(), 2, "{regions:?}");
+    let tris: Vec<[u32; 3]> = s.tris.clone();
+    m.check_against_surface(&tris).unwrap();
+
+    let tool = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/tools/meshcheck.py");
+    let ok = Command::new("python3")
+        .args(["-c", "import numpy, meshio"])
+        .status()
+        .map(|s| s.success())
+        .unwrap_or(false);
+    if !tool.exists() || !ok {
+        eprintln!("meshcheck skipped: meshcheck.py or python3 with numpy+meshio not available");
+        return;
+    }
+    let surf = tmp("demo_surface_for_check.vtu");
+    let o = bin()
+        .args(["demo", "--check-only", "-o"])
+        .arg(&surf)
+        .output()
+        .unwrap();
+    assert!(o.status.success());
+    let o = Command::new("python3")
+        .arg(&tool)
+        .arg(&vol)
+        .arg("--surface")
+        .arg(&surf)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stdout));
+}
