@@ -38,6 +38,8 @@ pub struct LooseGrid {
     pos: Vec<u32>,
     centre: Vec<P3>,
     len: usize,
+    /// Bit `k` set: level `k` holds items (queries skip the rest).
+    used: u64,
 }
 
 #[inline]
@@ -70,6 +72,7 @@ impl LooseGrid {
             pos: Vec::new(),
             centre: Vec::new(),
             len: 0,
+            used: 0,
         }
     }
 
@@ -127,6 +130,7 @@ impl LooseGrid {
         self.pos[i] = lv.items.len() as u32;
         lv.items.push(id);
         self.lvl[i] = k as u8;
+        self.used |= 1 << k;
         self.key[i] = key;
         self.centre[i] = c;
         self.len += 1;
@@ -152,6 +156,9 @@ impl LooseGrid {
         }
         let at = self.pos[i] as usize;
         lv.items.swap_remove(at);
+        if lv.items.is_empty() {
+            self.used &= !(1 << k);
+        }
         if at < lv.items.len() {
             self.pos[lv.items[at] as usize] = at as u32;
         }
@@ -162,10 +169,11 @@ impl LooseGrid {
     /// Calls `f(id)` for every item whose loose cell may overlap `q`
     /// (a superset: the caller filters exactly).
     pub fn query(&self, q: &Aabb, mut f: impl FnMut(u32)) {
-        for lv in &self.levels {
-            if lv.items.is_empty() {
-                continue;
-            }
+        let mut used = self.used;
+        while used != 0 {
+            let k = used.trailing_zeros() as usize;
+            used &= used - 1;
+            let lv = &self.levels[k];
             // Items sit within half a cell of their cell.
             let qq = q.inflated(0.5 * lv.cell);
             let lo = self.cell_of(qq.min, lv.cell);

@@ -298,7 +298,6 @@ impl<'a> Front<'a> {
         self.fgrid.query(&bb, |g| {
             if g != f {
                 near_f.push(Near {
-                    id: g,
                     v: self.fv[g as usize],
                     bb: tri_box(&self.pts, self.fv[g as usize]),
                 })

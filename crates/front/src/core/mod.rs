@@ -105,7 +105,6 @@ enum Outcome {
 
 #[derive(Clone, Copy)]
 struct Near {
-    id: u32,
     v: [u32; 3],
     bb: Aabb,
 }
@@ -649,7 +648,6 @@ impl<'a> Front<'a> {
         self.fgrid.query(&qbox, |g| {
             if g != fid {
                 near_f.push(Near {
-                    id: g,
                     v: self.fv[g as usize],
                     bb: tri_box(&self.pts, self.fv[g as usize]),
                 })
