@@ -17,6 +17,8 @@ mod cavity;
 /// Smallest mean ratio the front accepts: a flatter tet may be positive
 /// only in exact arithmetic, and a solver reads it as inverted.
 const SHAPE_FLOOR: f64 = 2e-3;
+/// A new tet's size is at most this multiple of its face's longest edge.
+const MAX_GROWTH_PER_TET: f64 = 2.0;
 
 const NONE: u32 = u32::MAX;
 
@@ -620,9 +622,12 @@ impl<'a> Front<'a> {
         }
         let nrm = normalize(tri_normal(pa, pb, pc));
         let m = centroid3(pa, pb, pc);
-        let h = (self.hp[v[0] as usize] + self.hp[v[1] as usize] + self.hp[v[2] as usize]) / 3.0;
-        let dm = (dist(m, pa) + dist(m, pb) + dist(m, pc)) / 3.0;
         let emax = dist(pa, pb).max(dist(pb, pc)).max(dist(pc, pa));
+        // A tet at most twice its face: sizes still grow geometrically, and a
+        // small face under a large size (CAD needles) keeps a local search.
+        let h = ((self.hp[v[0] as usize] + self.hp[v[1] as usize] + self.hp[v[2] as usize]) / 3.0)
+            .min(MAX_GROWTH_PER_TET * emax);
+        let dm = (dist(m, pa) + dist(m, pb) + dist(m, pc)) / 3.0;
         // AF2.1: the ideal point sits at a regular tet's height.
         let alpha = (h * h - dm * dm).max(0.25 * dm * dm).sqrt();
         let pstar = add(m, scale(nrm, alpha));
