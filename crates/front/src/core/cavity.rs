@@ -153,12 +153,17 @@ impl<'a> Front<'a> {
             })
             .sum::<f64>()
             / pocket.len() as f64;
-        let mut crowded = false;
-        self.pgrid
-            .query(&Aabb { min: p, max: p }.inflated(0.2 * hmean), |q| {
-                crowded |= dist2(self.pts[q as usize], p) < 0.04 * hmean * hmean
-            });
-        if crowded {
+        let (mut nf, mut np) = (Vec::new(), Vec::new());
+        self.gather(
+            &Aabb { min: p, max: p }.inflated(0.2 * hmean),
+            NONE,
+            &mut nf,
+            &mut np,
+        );
+        if np
+            .iter()
+            .any(|&q| dist2(self.pts[q as usize], p) < 0.04 * hmean * hmean)
+        {
             return Pocket::Failed;
         }
         let mut take = Vec::new();
@@ -275,7 +280,7 @@ impl<'a> Front<'a> {
     }
 
     /// Every cone tet crosses no other front face and holds no front point.
-    fn cone_is_free(&self, pocket: &[u32], p: P3) -> bool {
+    fn cone_is_free(&mut self, pocket: &[u32], p: P3) -> bool {
         pocket
             .iter()
             .all(|&f| self.cone_free(f, p, Clearance::EXACT))
@@ -283,7 +288,7 @@ impl<'a> Front<'a> {
 
     /// The tet on face `f` with apex `p` is free, checked against the front
     /// around it alone.
-    fn cone_free(&self, f: u32, p: P3, cl: Clearance) -> bool {
+    fn cone_free(&mut self, f: u32, p: P3, cl: Clearance) -> bool {
         let v = self.fv[f as usize];
         let [a, b, c] = v.map(|i| self.pts[i as usize]);
         if orient3d(a, b, c, p) <= 0.0 {
@@ -292,17 +297,8 @@ impl<'a> Front<'a> {
         let bb = tri_box(&self.pts, v)
             .union(&Aabb { min: p, max: p })
             .inflated(cl.point);
-        let mut near_f = Vec::new();
-        let mut near_p = Vec::new();
-        self.pgrid.query(&bb, |q| near_p.push(q));
-        self.fgrid.query(&bb, |g| {
-            if g != f {
-                near_f.push(Near {
-                    v: self.fv[g as usize],
-                    bb: tri_box(&self.pts, self.fv[g as usize]),
-                })
-            }
-        });
+        let (mut near_f, mut near_p) = (Vec::new(), Vec::new());
+        self.gather(&bb, f, &mut near_f, &mut near_p);
         self.tet_is_free(v, NONE, p, &near_f, &near_p, cl)
     }
 

@@ -121,8 +121,6 @@ struct Front<'a> {
     ftries: Vec<u8>,
     fmap: FxHashMap<[u32; 3], u32>,
     heap: BinaryHeap<Reverse<(u64, u32)>>,
-    pcount: Vec<u32>,
-    pgrid: LooseGrid,
     fgrid: LooseGrid,
     tets: Vec<[u32; 4]>,
     neigh: Vec<u32>,
@@ -138,6 +136,9 @@ struct Front<'a> {
     near_f: Vec<Near>,
     near_p: Vec<u32>,
     cands: Vec<(f64, u32)>,
+    /// Per point: the query that last saw it (dedups corners of faces).
+    stamp: Vec<u32>,
+    epoch: u32,
 }
 
 #[inline]
@@ -336,8 +337,6 @@ pub fn advance(
         ftries: Vec::new(),
         fmap: FxHashMap::default(),
         heap: BinaryHeap::new(),
-        pcount: vec![0; n],
-        pgrid: LooseGrid::new(s0, bb.min),
         fgrid: LooseGrid::new(s0, bb.min),
         tets: Vec::new(),
         neigh: Vec::new(),
@@ -352,6 +351,8 @@ pub fn advance(
         near_f: Vec::new(),
         near_p: Vec::new(),
         cands: Vec::new(),
+        stamp: Vec::new(),
+        epoch: 0,
     };
     if let SizeMode::Growth(c) = size {
         // §5: initial face sizes are multiplied by the growth factor.
@@ -411,14 +412,6 @@ impl<'a> Front<'a> {
         self.fowner.push(owner);
         self.ftries.push(0);
         self.fmap.insert(sorted3(v), id);
-        for &p in &v {
-            let c = &mut self.pcount[p as usize];
-            *c += 1;
-            if *c == 1 {
-                self.pgrid
-                    .insert(p, self.pts[p as usize], self.hp[p as usize]);
-            }
-        }
         let bb = tri_box(&self.pts, v);
         let ext = (0..3).map(|k| bb.max[k] - bb.min[k]).fold(0.0, f64::max);
         self.fgrid.insert(id, bb.center(), ext);
@@ -433,13 +426,40 @@ impl<'a> Front<'a> {
         let v = self.fv[i];
         self.fmap.remove(&sorted3(v));
         self.fgrid.remove(id);
-        for &p in &v {
-            let c = &mut self.pcount[p as usize];
-            *c -= 1;
-            if *c == 0 {
-                self.pgrid.remove(p);
-            }
+    }
+
+    /// The front faces (all but `skip`) whose boxes meet `q`, and the
+    /// front points inside `q`. Front points are the corners of front
+    /// faces, so one face query finds both.
+    fn gather(&mut self, q: &Aabb, skip: u32, near_f: &mut Vec<Near>, near_p: &mut Vec<u32>) {
+        let mut stamp = std::mem::take(&mut self.stamp);
+        stamp.resize(self.pts.len(), 0);
+        self.epoch = self.epoch.wrapping_add(1);
+        if self.epoch == 0 {
+            stamp.iter_mut().for_each(|s| *s = 0);
+            self.epoch = 1;
         }
+        let epoch = self.epoch;
+        self.fgrid.query(q, |g| {
+            let w = self.fv[g as usize];
+            let bb = tri_box(&self.pts, w);
+            if !bb.overlaps(q) {
+                return;
+            }
+            for &p in &w {
+                let s = &mut stamp[p as usize];
+                if *s != epoch {
+                    *s = epoch;
+                    if q.contains(self.pts[p as usize]) {
+                        near_p.push(p);
+                    }
+                }
+            }
+            if g != skip {
+                near_f.push(Near { v: w, bb })
+            }
+        });
+        self.stamp = stamp;
     }
 
     fn run(&mut self) -> Result<(), FrontError> {
@@ -649,15 +669,7 @@ impl<'a> Front<'a> {
         near_p.clear();
         near_f.clear();
         cands.clear();
-        self.pgrid.query(&qbox, |p| near_p.push(p));
-        self.fgrid.query(&qbox, |g| {
-            if g != fid {
-                near_f.push(Near {
-                    v: self.fv[g as usize],
-                    bb: tri_box(&self.pts, self.fv[g as usize]),
-                })
-            }
-        });
+        self.gather(&qbox, fid, &mut near_f, &mut near_p);
         // The grid's layout follows from the order of operations alone, so
         // the query order is deterministic without sorting.
         let mut star_clear = true;
@@ -673,9 +685,8 @@ impl<'a> Front<'a> {
             if !self.region.point_ok(pq) {
                 continue; // §7: a close point outside the region is dropped
             }
-            if orient3d(pa, pb, pc, pq) <= 0.0 {
-                continue;
-            }
+            // A mean ratio over the floor is a volume far above rounding:
+            // the float sign is the exact one, no predicate needed here.
             let (shape, mut score) = candidate_score(pa, pb, pc, pq, h);
             if shape <= SHAPE_FLOOR {
                 continue;
@@ -840,7 +851,6 @@ impl<'a> Front<'a> {
             let h = self.new_point_size(v, pq);
             self.pts.push(pq);
             self.hp.push(h);
-            self.pcount.push(0);
             self.stats.new_points += 1;
             id
         } else {
