@@ -281,18 +281,31 @@ impl SeparatingPlanes {
         (0..4).all(|i| dot(self.n[i], sub(x, self.o[i])) * self.inv_len[i] < margin)
     }
 
+    /// `gl[j]`: the tet's local index of `g[j]` when it is a tet corner,
+    /// else 4. A plane through every shared corner with the other corners
+    /// strictly outside leaves `g` meeting the tet in shared corners only.
     #[inline]
-    fn separates(&self, g: &[P3; 3]) -> bool {
+    fn separates(&self, g: &[P3; 3], gl: [usize; 3]) -> bool {
         'planes: for i in 0..4 {
-            for x in g {
-                let d = sub(*x, self.o[i]);
+            let mut outside = 0;
+            for j in 0..3 {
+                if gl[j] < 4 {
+                    if gl[j] == i {
+                        continue 'planes; // plane i does not hold this corner
+                    }
+                    continue;
+                }
+                let d = sub(g[j], self.o[i]);
                 let s = dot(self.n[i], d);
                 let err = 1e-12 * self.nn[i] * (d[0].abs() + d[1].abs() + d[2].abs());
                 if s <= err {
                     continue 'planes;
                 }
+                outside += 1;
             }
-            return true;
+            if outside > 0 {
+                return true;
+            }
         }
         false
     }
@@ -792,9 +805,8 @@ impl<'a> Front<'a> {
             }
             let g = nf.v;
             let gp = g.map(|i| self.pts[i as usize]);
-            if planes.separates(&gp) {
-                continue;
-            }
+            let gl = g.map(|x| tv.iter().position(|&y| y == x).unwrap_or(4));
+            let apart = planes.separates(&gp, gl);
             for lf in &new_faces {
                 let fvid = lf.map(|k| tv[k]);
                 let shared = fvid.iter().filter(|x| g.contains(x)).count();
@@ -810,6 +822,9 @@ impl<'a> Front<'a> {
                     && thin_wedge(fvid, lf.map(|k| tp[k]), g, gp, cl.wedge)
                 {
                     return false;
+                }
+                if apart {
+                    continue;
                 }
                 let (fp, gq) = shared_first(fvid, lf.map(|k| tp[k]), g, gp);
                 if triangles_intersect(fp, gq, shared) {
