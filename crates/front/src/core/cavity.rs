@@ -9,10 +9,15 @@ use crate::quality::mean_ratio;
 
 /// Smallest mean ratio of a cone tet: far from flat in floating point.
 const CONE_FLOOR: f64 = 2e-3;
+/// The floor when only input faces are seen worse than `CONE_FLOOR`: a
+/// volume still about 1e-8 of the edge cubed, far above rounding.
+const INPUT_BOUND_FLOOR: f64 = 1e-5;
 /// Pockets larger than this are not coned (the cone would be poor and the
 /// search slow); recovery removes layers instead.
 const MAX_POCKET: usize = 400;
 const MAX_GROWTH: usize = 24;
+/// Pockets up to this many faces may be closed from their own corners.
+const MAX_EXHAUSTIVE: usize = 24;
 
 enum Pocket {
     Filled,
@@ -112,6 +117,20 @@ impl<'a> Front<'a> {
                 .collect();
             dead.sort_unstable();
             dead.dedup();
+            if dead.is_empty()
+                && self.worst_cone(&pocket, p) >= INPUT_BOUND_FLOOR
+                && self.region.point_ok(p)
+                && self.cone_is_free(&pocket, p)
+            {
+                // The input itself leaves no room for better (a thin part
+                // between close input faces): a flat but float-safe cone.
+                self.commit_cone(&pocket, p);
+                return Pocket::Filled;
+            }
+            if dead.is_empty() && pocket.len() <= MAX_EXHAUSTIVE && self.close_by_existing(&pocket)
+            {
+                return Pocket::Filled;
+            }
             if dead.is_empty() || round + 1 == MAX_GROWTH {
                 // Only input faces are seen badly, or growth is not
                 // converging: cone what the point sees well.
@@ -189,6 +208,68 @@ impl<'a> Front<'a> {
         }
         self.stats.pockets_filled += 1;
         Pocket::Partial
+    }
+
+    /// Close a small pocket with tets on its own corners, best first: the
+    /// space between close input faces may need no new point, only tets
+    /// flatter than the front accepts. Undone if it does not close.
+    fn close_by_existing(&mut self, pocket: &[u32]) -> bool {
+        let mut faces: Vec<u32> = pocket.to_vec();
+        let mut made = Vec::new();
+        for _ in 0..4 * pocket.len() {
+            let corners: Vec<u32> = {
+                let mut c: Vec<u32> = faces.iter().flat_map(|&f| self.fv[f as usize]).collect();
+                c.sort_unstable();
+                c.dedup();
+                c
+            };
+            let mut best: Option<(f64, u32, u32)> = None;
+            for &f in &faces {
+                let v = self.fv[f as usize];
+                let [a, b, c] = v.map(|i| self.pts[i as usize]);
+                for &q in &corners {
+                    if v.contains(&q) {
+                        continue;
+                    }
+                    let shape = mean_ratio(a, b, c, self.pts[q as usize]);
+                    if shape < INPUT_BOUND_FLOOR || best.is_some_and(|b| b.0 >= shape) {
+                        continue;
+                    }
+                    if orient3d(a, b, c, self.pts[q as usize]) > 0.0 && self.existing_free(f, q) {
+                        best = Some((shape, f, q));
+                    }
+                }
+            }
+            let Some((_, f, q)) = best else {
+                break;
+            };
+            let before = self.fv.len() as u32;
+            made.push(self.tets.len() as u32);
+            self.commit(f, q, self.pts[q as usize]);
+            faces.retain(|&g| self.falive[g as usize]);
+            faces.extend((before..self.fv.len() as u32).filter(|&g| self.falive[g as usize]));
+            if faces.is_empty() {
+                self.stats.pockets_filled += 1;
+                return true;
+            }
+        }
+        // Not closed: take the tets back out; the pocket is as it was.
+        for &t in &made {
+            self.talive[t as usize] = false;
+        }
+        for &t in made.iter().rev() {
+            self.unlink_tet(t);
+        }
+        false
+    }
+
+    fn existing_free(&mut self, f: u32, q: u32) -> bool {
+        let v = self.fv[f as usize];
+        let pq = self.pts[q as usize];
+        let bb = tri_box(&self.pts, v).union(&Aabb { min: pq, max: pq });
+        let (mut near_f, mut near_p) = (Vec::new(), Vec::new());
+        self.gather(&bb, f, &mut near_f, &mut near_p);
+        self.tet_is_free(v, q, pq, &near_f, &near_p, Clearance::EXACT)
     }
 
     fn prohibited_face(&self, f: u32) -> bool {
