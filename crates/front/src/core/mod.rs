@@ -736,12 +736,16 @@ impl<'a> Front<'a> {
             }
         }
         cands.sort_unstable_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
-        let min_score = match self.relax + self.ftries[fid as usize] as u32 {
-            0 => 0.12,
+        // Relative to the best this face allows: a needle surface triangle
+        // makes no good tet at all, and must not wait for recovery.
+        let best = candidate_score(pa, pb, pc, pstar, h).0;
+        let min_score: f64 = match self.relax + self.ftries[fid as usize] as u32 {
+            0 => 0.12f64,
             1 => 0.05,
             2 => 0.01,
             _ => 0.0,
-        };
+        }
+        .min(0.3 * best);
         // Kept clear of other front points (a fraction of the size).
         let cl = Clearance::for_round(self.relax + self.ftries[fid as usize] as u32, h);
         let mut placed = None;
