@@ -39,7 +39,7 @@ impl Default for FrontOptions {
     fn default() -> Self {
         FrontOptions {
             tries_per_face: 3,
-            recovery_rounds: 30,
+            recovery_rounds: 60,
             max_points: u32::MAX as usize - 1,
             progress_every: 0,
         }

@@ -1,0 +1,61 @@
+//! Meshing the shared corpus with default options (skipped when
+//! PARAFRONT_GEOMETRY is unset). Each mesh must keep its surface and fill it
+//! exactly. The CAD parts with sliver triangles (hinge, plate_holes, tray)
+//! and the two largest models (boot, skull: about a minute each) are not in
+//! this list yet; see BENCHMARKS.md.
+use parafront_pipeline::{mesh_surface, MeshOptions};
+use parafront_surface::read::read_surface;
+use std::path::PathBuf;
+
+fn corpus() -> Option<PathBuf> {
+    match std::env::var_os("PARAFRONT_GEOMETRY") {
+        Some(d) => Some(PathBuf::from(d).join("valid")),
+        None => {
+            println!("PARAFRONT_GEOMETRY unset: corpus meshing skipped");
+            None
+        }
+    }
+}
+
+fn mesh_file(file: &str) {
+    let Some(dir) = corpus() else { return };
+    let s = read_surface(&dir.join(file)).unwrap_or_else(|e| panic!("{file}: {e}"));
+    let (m, summary) = mesh_surface(&s, &MeshOptions::default())
+        .unwrap_or_else(|e| panic!("{file}: meshing failed: {e}"));
+    let stats = m
+        .check_against_surface(&s.tris)
+        .unwrap_or_else(|e| panic!("{file}: invalid mesh: {e}"));
+    let _ = stats;
+    println!(
+        "{file}: {} tets, front {:.2} s, {} recovery rounds",
+        m.tets.len(),
+        summary.seconds("front"),
+        summary.recovery_rounds
+    );
+    assert!(m.tets.len() > s.tris.len(), "{file}: {} tets", m.tets.len());
+}
+
+#[test]
+fn thin_plate() {
+    mesh_file("base_interface_gmsh.stl");
+}
+
+#[test]
+fn box_with_five_voids() {
+    mesh_file("discrete_voids.obj");
+}
+
+#[test]
+fn fandisk() {
+    mesh_file("fandisk.off");
+}
+
+#[test]
+fn fertility_genus_four() {
+    mesh_file("fertility.off");
+}
+
+#[test]
+fn spot() {
+    mesh_file("spot.obj");
+}
