@@ -203,7 +203,7 @@ fn mesh_options(a: &MeshArgs) -> Result<MeshOptions, Fail> {
 }
 
 fn run_mesh(s: &Surface, name: &str, out: &Path, a: &MeshArgs, w: &WriteArgs) -> Result<(), Fail> {
-    let opts = mesh_options(a)?;
+    let mut opts = mesh_options(a)?;
     let wopts = write_options(w, Some(s))?;
     if parafront_io::Format::from_path(out).is_none() {
         return Err(Fail(
@@ -225,7 +225,12 @@ fn run_mesh(s: &Surface, name: &str, out: &Path, a: &MeshArgs, w: &WriteArgs) ->
         s.points.len(),
         s.tris.len()
     );
-    let (mesh, mut sum) = mesh_surface(s, &opts).map_err(|e| match e {
+    let progress = std::sync::Arc::new(parafront_front::Progress::default());
+    opts.progress = Some(progress.clone());
+    let bar = ProgressLine::start(progress);
+    let res = mesh_surface(s, &opts);
+    bar.finish();
+    let (mesh, mut sum) = res.map_err(|e| match e {
         MeshError::InvalidSurface(_) => Fail(1, format!("{name}: {e}")),
         e => Fail(1, format!("{name}: {e}")),
     })?;
@@ -240,6 +245,52 @@ fn run_mesh(s: &Surface, name: &str, out: &Path, a: &MeshArgs, w: &WriteArgs) ->
         println!("wrote {}", p.display());
     }
     Ok(())
+}
+
+/// The front's progress on a terminal: tets made, front size, rate.
+/// indicatif draws nothing when stderr is not a terminal.
+struct ProgressLine {
+    stop: std::sync::Arc<std::sync::atomic::AtomicBool>,
+    handle: Option<std::thread::JoinHandle<()>>,
+}
+
+impl ProgressLine {
+    fn start(p: std::sync::Arc<parafront_front::Progress>) -> ProgressLine {
+        use std::sync::atomic::{AtomicBool, Ordering};
+        let stop = std::sync::Arc::new(AtomicBool::new(false));
+        let flag = stop.clone();
+        let handle = std::thread::spawn(move || {
+            let bar = indicatif::ProgressBar::new_spinner();
+            bar.set_style(
+                indicatif::ProgressStyle::with_template("{spinner} {elapsed} {msg}")
+                    .unwrap_or_else(|_| indicatif::ProgressStyle::default_spinner()),
+            );
+            let t0 = Instant::now();
+            while !flag.load(Ordering::Relaxed) {
+                let tets = p.tets();
+                let rate = tets as f64 / t0.elapsed().as_secs_f64().max(1e-9);
+                let mut msg = format!("{tets} tets, front {} faces, {rate:.0} tets/s", p.front());
+                if p.rounds() > 0 {
+                    msg.push_str(&format!(", recovery round {}", p.rounds()));
+                }
+                bar.set_message(msg);
+                bar.tick();
+                std::thread::sleep(std::time::Duration::from_millis(100));
+            }
+            bar.finish_and_clear();
+        });
+        ProgressLine {
+            stop,
+            handle: Some(handle),
+        }
+    }
+
+    fn finish(mut self) {
+        self.stop.store(true, std::sync::atomic::Ordering::Relaxed);
+        if let Some(h) = self.handle.take() {
+            let _ = h.join();
+        }
+    }
 }
 
 fn print_summary(sum: &Summary, q: &QualityReport) {

@@ -15,6 +15,37 @@ mod quality;
 
 pub use crate::core::{advance, FrontError, FrontInput, FrontOptions, FrontResult, FrontStats};
 
+use std::sync::atomic::{AtomicU64, Ordering};
+
+/// Counters a front updates as it works, for a progress display on another
+/// thread. Relaxed atomics: a display needs no ordering.
+#[derive(Debug, Default)]
+pub struct Progress {
+    tets: AtomicU64,
+    front: AtomicU64,
+    rounds: AtomicU64,
+}
+
+impl Progress {
+    /// Tets made so far (recovery's removals are not subtracted).
+    pub fn tets(&self) -> u64 {
+        self.tets.load(Ordering::Relaxed)
+    }
+    /// Faces in the front now.
+    pub fn front(&self) -> u64 {
+        self.front.load(Ordering::Relaxed)
+    }
+    /// Recovery rounds so far.
+    pub fn rounds(&self) -> u64 {
+        self.rounds.load(Ordering::Relaxed)
+    }
+    pub(crate) fn set(&self, tets: u64, front: u64, rounds: u64) {
+        self.tets.store(tets, Ordering::Relaxed);
+        self.front.store(front, Ordering::Relaxed);
+        self.rounds.store(rounds, Ordering::Relaxed);
+    }
+}
+
 use parafront_geom::P3;
 
 /// Where a pass may mesh (paper §7). The front skips faces whose points,

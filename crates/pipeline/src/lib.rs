@@ -30,6 +30,10 @@ pub struct MeshOptions {
     /// Skip the final validity check (not recommended; it is cheap).
     #[serde(default)]
     pub no_check: bool,
+    /// Counters the front updates, for a progress display (not an option
+    /// a file can set).
+    #[serde(skip)]
+    pub progress: Option<std::sync::Arc<parafront_front::Progress>>,
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -111,7 +115,10 @@ pub fn mesh_surface(s: &Surface, opts: &MeshOptions) -> Result<(TetMesh, Summary
             input,
             SizeMode::Field(&field),
             &parafront_front::Everywhere,
-            &FrontOptions::default(),
+            &FrontOptions {
+                progress: opts.progress.clone(),
+                ..FrontOptions::default()
+            },
         )
         .map_err(|e| MeshError::Front {
             region: r,

@@ -33,6 +33,8 @@ pub struct FrontOptions {
     pub max_points: usize,
     /// Report progress every this many tets (0: never).
     pub progress_every: usize,
+    /// Where to report it.
+    pub progress: Option<std::sync::Arc<crate::Progress>>,
 }
 
 impl Default for FrontOptions {
@@ -41,7 +43,8 @@ impl Default for FrontOptions {
             tries_per_face: 3,
             recovery_rounds: 60,
             max_points: u32::MAX as usize - 1,
-            progress_every: 0,
+            progress_every: 4096,
+            progress: None,
         }
     }
 }
@@ -902,7 +905,13 @@ impl<'a> Front<'a> {
             }
         }
         if self.opts.progress_every > 0 && self.stats.tets % self.opts.progress_every == 0 {
-            tracing::trace!(tets = self.stats.tets, front = self.fmap.len(), "front");
+            if let Some(p) = &self.opts.progress {
+                p.set(
+                    self.stats.tets as u64,
+                    self.fmap.len() as u64,
+                    self.relax as u64,
+                );
+            }
         }
     }
 
