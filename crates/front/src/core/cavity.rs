@@ -15,7 +15,7 @@ const INPUT_BOUND_FLOOR: f64 = 1e-5;
 /// Pockets larger than this are not coned (the cone would be poor and the
 /// search slow); recovery removes layers instead.
 const MAX_POCKET: usize = 400;
-const MAX_GROWTH: usize = 24;
+const MAX_GROWTH: usize = 12;
 /// Pockets up to this many faces may be closed from their own corners.
 const MAX_EXHAUSTIVE: usize = 24;
 

@@ -17,6 +17,8 @@ mod cavity;
 /// Smallest mean ratio the front accepts: a flatter tet may be positive
 /// only in exact arithmetic, and a solver reads it as inverted.
 const SHAPE_FLOOR: f64 = 2e-3;
+/// Recovery rounds without fewer stuck faces before the front gives up.
+const STALL_ROUNDS: u32 = 15;
 /// A new tet's size is at most this multiple of its face's longest edge.
 const MAX_GROWTH_PER_TET: f64 = 2.0;
 
@@ -479,6 +481,8 @@ impl<'a> Front<'a> {
     }
 
     fn run(&mut self) -> Result<(), FrontError> {
+        let mut fewest_stuck = usize::MAX;
+        let mut last_gain = 0;
         loop {
             while let Some(Reverse((key, fid))) = self.heap.pop() {
                 if !self.falive[fid as usize] {
@@ -509,7 +513,13 @@ impl<'a> Front<'a> {
             if self.stuck.is_empty() {
                 return Ok(());
             }
-            if self.relax >= self.opts.recovery_rounds {
+            // Give up early when recovery stops making headway, rather than
+            // spend every round on a front it cannot close.
+            if self.stuck.len() < fewest_stuck {
+                fewest_stuck = self.stuck.len();
+                last_gain = self.relax;
+            }
+            if self.relax >= self.opts.recovery_rounds || self.relax >= last_gain + STALL_ROUNDS {
                 let f = self.stuck[0];
                 let v = self.fv[f as usize];
                 let c = centroid3(
@@ -673,7 +683,8 @@ impl<'a> Front<'a> {
         }
         // AF2.2: close points and faces, from one box holding every
         // candidate tet.
-        let relax = self.relax.min(6) as f64;
+        // Wider searches on later rounds, but bounded: near lists grow as r^3.
+        let relax = self.relax.min(2) as f64;
         let r = h.max(emax) * (1.0 + 0.35 * relax + 0.25 * self.ftries[fid as usize] as f64);
         let cq = add(m, scale(nrm, 0.5 * alpha));
         let qbox = Aabb { min: cq, max: cq }
