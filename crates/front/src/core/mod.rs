@@ -17,6 +17,10 @@ mod cavity;
 /// Smallest mean ratio the front accepts: a flatter tet may be positive
 /// only in exact arithmetic, and a solver reads it as inverted.
 const SHAPE_FLOOR: f64 = 2e-3;
+/// Close-point search radius on a first try, in units of the local size.
+/// Measured on sphere_1e5: 1.0 gave 35k tets/s and 2.5 % under 10 degrees,
+/// 0.7 gives 53k and 2.4 %, 0.5 gets stuck far more often.
+const SEARCH_RADIUS: f64 = 0.7;
 /// Recovery rounds without fewer stuck faces before the front gives up.
 const STALL_ROUNDS: u32 = 15;
 /// A new tet's size is at most this multiple of its face's longest edge.
@@ -685,7 +689,8 @@ impl<'a> Front<'a> {
         // candidate tet.
         // Wider searches on later rounds, but bounded: near lists grow as r^3.
         let relax = self.relax.min(2) as f64;
-        let r = h.max(emax) * (1.0 + 0.35 * relax + 0.25 * self.ftries[fid as usize] as f64);
+        let r =
+            h.max(emax) * (SEARCH_RADIUS + 0.35 * relax + 0.25 * self.ftries[fid as usize] as f64);
         let cq = add(m, scale(nrm, 0.5 * alpha));
         let qbox = Aabb { min: cq, max: cq }
             .inflated(r)
