@@ -22,7 +22,7 @@ const SHAPE_FLOOR: f64 = 2e-3;
 /// 0.7 gives 53k and 2.4 %, 0.5 gets stuck far more often.
 const SEARCH_RADIUS: f64 = 0.7;
 /// Recovery rounds without fewer stuck faces before the front gives up.
-const STALL_ROUNDS: u32 = 15;
+const STALL_ROUNDS: u32 = 8;
 /// A new tet's size is at most this multiple of its face's longest edge.
 const MAX_GROWTH_PER_TET: f64 = 2.0;
 
