@@ -96,8 +96,9 @@ fn convert_round_trips_a_box_mesh_through_every_format() {
     assert!(String::from_utf8_lossy(&o.stdout).contains("dihedral"));
 }
 
-#[test]
-fn a_box_mesh_passes_meshcheck() {
+/// `../shared/tools/meshcheck.py --surface` passes on `vol`, when the tool
+/// and python3 with numpy and meshio are there.
+fn meshcheck(vol: &Path, surf: &Path) {
     let tool = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/tools/meshcheck.py");
     let ok = Command::new("python3")
         .args(["-c", "import numpy, meshio"])
@@ -105,9 +106,21 @@ fn a_box_mesh_passes_meshcheck() {
         .map(|s| s.success())
         .unwrap_or(false);
     if !tool.exists() || !ok {
-        eprintln!("skipped: meshcheck.py or python3 with numpy+meshio not available");
+        eprintln!("meshcheck skipped: meshcheck.py or python3 with numpy+meshio not available");
         return;
     }
+    let o = Command::new("python3")
+        .arg(&tool)
+        .arg(vol)
+        .arg("--surface")
+        .arg(surf)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stdout));
+}
+
+#[test]
+fn a_box_mesh_passes_meshcheck() {
     let m = parafront_mesh::generate::box_mesh(4, 3, 2, [0.0; 3], [2.0, 1.5, 1.0]);
     m.check_against_surface(
         &m.bnd_tris
@@ -126,14 +139,7 @@ fn a_box_mesh_passes_meshcheck() {
         ..Default::default()
     };
     parafront_io::write_mesh(&surf, &s, &Default::default()).unwrap();
-    let o = Command::new("python3")
-        .arg(&tool)
-        .arg(&vol)
-        .arg("--surface")
-        .arg(&surf)
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stdout));
+    meshcheck(&vol, &surf);
 }
 
 #[test]
@@ -191,16 +197,6 @@ fn demo_mesh_passes_meshcheck() {
     let tris: Vec<[u32; 3]> = s.tris.clone();
     m.check_against_surface(&tris).unwrap();
 
-    let tool = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/tools/meshcheck.py");
-    let ok = Command::new("python3")
-        .args(["-c", "import numpy, meshio"])
-        .status()
-        .map(|s| s.success())
-        .unwrap_or(false);
-    if !tool.exists() || !ok {
-        eprintln!("meshcheck skipped: meshcheck.py or python3 with numpy+meshio not available");
-        return;
-    }
     let surf = tmp("demo_surface_for_check.vtu");
     let o = bin()
         .args(["demo", "--check-only", "-o"])
@@ -208,12 +204,5 @@ fn demo_mesh_passes_meshcheck() {
         .output()
         .unwrap();
     assert!(o.status.success());
-    let o = Command::new("python3")
-        .arg(&tool)
-        .arg(&vol)
-        .arg("--surface")
-        .arg(&surf)
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stdout));
+    meshcheck(&vol, &surf);
 }
