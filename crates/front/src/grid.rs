@@ -40,9 +40,6 @@ pub struct LooseGrid {
     len: usize,
     /// Bit `k` set: level `k` holds items (queries skip the rest).
     used: u64,
-    /// Items are points: they sit inside their cell, so queries need no
-    /// loose margin.
-    points: bool,
 }
 
 #[inline]
@@ -76,16 +73,6 @@ impl LooseGrid {
             centre: Vec::new(),
             len: 0,
             used: 0,
-            points: false,
-        }
-    }
-
-    /// A grid of points: `extent` at insertion only picks the level (the
-    /// cell size that suits the queries around the point).
-    pub fn for_points(s0: f64, origin: P3) -> LooseGrid {
-        LooseGrid {
-            points: true,
-            ..LooseGrid::new(s0, origin)
         }
     }
 
@@ -187,12 +174,8 @@ impl LooseGrid {
             let k = used.trailing_zeros() as usize;
             used &= used - 1;
             let lv = &self.levels[k];
-            // Items sit within half a cell of their cell; points inside it.
-            let qq = if self.points {
-                *q
-            } else {
-                q.inflated(0.5 * lv.cell)
-            };
+            // Items sit within half a cell of their cell.
+            let qq = q.inflated(0.5 * lv.cell);
             let lo = self.cell_of(qq.min, lv.cell);
             let hi = self.cell_of(qq.max, lv.cell);
             let ncell = (hi[0] - lo[0] + 1) as f64

@@ -95,13 +95,7 @@ pub fn icosphere(center: P3, radius: f64, subdiv: u32) -> Surface {
         tris = next;
     }
     let points = pts.iter().map(|p| add(center, scale(*p, radius))).collect();
-    let n = tris.len();
-    Surface {
-        points,
-        tris,
-        patch: vec![0; n],
-        patch_names: Vec::new(),
-    }
+    Surface::one_patch(points, tris)
 }
 
 /// Torus around the z axis with outward normals.
@@ -124,13 +118,7 @@ pub fn torus(center: P3, major: f64, minor: f64, nu: usize, nv: usize) -> Surfac
             tris.push([a, c, d]);
         }
     }
-    let n = tris.len();
-    Surface {
-        points,
-        tris,
-        patch: vec![0; n],
-        patch_names: Vec::new(),
-    }
+    Surface::one_patch(points, tris)
 }
 
 /// Boundary of a union of voxels: cell `(i,j,k)` of size `h` from `origin`

@@ -29,6 +29,17 @@ pub struct Surface {
 }
 
 impl Surface {
+    /// A surface whose triangles all belong to patch 0.
+    pub fn one_patch(points: Vec<parafront_geom::P3>, tris: Vec<[u32; 3]>) -> Surface {
+        let n = tris.len();
+        Surface {
+            points,
+            tris,
+            patch: vec![0; n],
+            patch_names: Vec::new(),
+        }
+    }
+
     pub fn bbox(&self) -> parafront_geom::Aabb {
         parafront_geom::Aabb::from_points(&self.points)
     }

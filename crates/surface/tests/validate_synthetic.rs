@@ -6,13 +6,7 @@ use parafront_surface::Surface;
 type P3 = [f64; 3];
 
 fn surf(points: Vec<P3>, tris: Vec<[u32; 3]>) -> Surface {
-    let n = tris.len();
-    Surface {
-        points,
-        tris,
-        patch: vec![0; n],
-        patch_names: Vec::new(),
-    }
+    Surface::one_patch(points, tris)
 }
 
 fn merge(parts: &[Surface]) -> Surface {

@@ -194,7 +194,7 @@ impl<'a> Front<'a> {
                 point: 0.02 * hmean,
                 wedge: 0.05,
             };
-            if self.cone_free(f, p, cl) {
+            if self.apex_free(f, NONE, p, cl) {
                 take.push(f);
             }
         }
@@ -235,7 +235,7 @@ impl<'a> Front<'a> {
                     if shape < INPUT_BOUND_FLOOR || best.is_some_and(|b| b.0 >= shape) {
                         continue;
                     }
-                    if orient3d(a, b, c, self.pts[q as usize]) > 0.0 && self.existing_free(f, q) {
+                    if self.apex_free(f, q, self.pts[q as usize], Clearance::EXACT) {
                         best = Some((shape, f, q));
                     }
                 }
@@ -261,15 +261,6 @@ impl<'a> Front<'a> {
             self.unlink_tet(t);
         }
         false
-    }
-
-    fn existing_free(&mut self, f: u32, q: u32) -> bool {
-        let v = self.fv[f as usize];
-        let pq = self.pts[q as usize];
-        let bb = tri_box(&self.pts, v).union(&Aabb { min: pq, max: pq });
-        let (mut near_f, mut near_p) = (Vec::new(), Vec::new());
-        self.gather(&bb, f, &mut near_f, &mut near_p);
-        self.tet_is_free(v, q, pq, &near_f, &near_p, Clearance::EXACT)
     }
 
     fn prohibited_face(&self, f: u32) -> bool {
@@ -364,12 +355,12 @@ impl<'a> Front<'a> {
     fn cone_is_free(&mut self, pocket: &[u32], p: P3) -> bool {
         pocket
             .iter()
-            .all(|&f| self.cone_free(f, p, Clearance::EXACT))
+            .all(|&f| self.apex_free(f, NONE, p, Clearance::EXACT))
     }
 
-    /// The tet on face `f` with apex `p` is free, checked against the front
-    /// around it alone.
-    fn cone_free(&mut self, f: u32, p: P3, cl: Clearance) -> bool {
+    /// The tet on face `f` with apex `p` (point `q`, or `NONE` for a new
+    /// one) is positive and free, checked against the front around it alone.
+    fn apex_free(&mut self, f: u32, q: u32, p: P3, cl: Clearance) -> bool {
         let v = self.fv[f as usize];
         let [a, b, c] = v.map(|i| self.pts[i as usize]);
         if orient3d(a, b, c, p) <= 0.0 {
@@ -380,7 +371,7 @@ impl<'a> Front<'a> {
             .inflated(cl.point);
         let (mut near_f, mut near_p) = (Vec::new(), Vec::new());
         self.gather(&bb, f, &mut near_f, &mut near_p);
-        self.tet_is_free(v, NONE, p, &near_f, &near_p, cl)
+        self.tet_is_free(v, q, p, &near_f, &near_p, cl)
     }
 
     fn commit_cone(&mut self, pocket: &[u32], p: P3) {
