@@ -74,3 +74,63 @@ fn fills_a_torus() {
     let (m, st) = fill(&s, 0.3);
     eprintln!("torus: {} tets, {:?}", m.tets.len(), st);
 }
+
+/// §7 hand-over: a pass meshes only where x < 0.1 and returns the rest of
+/// the front; a serial pass closes that front; the union is the mesh.
+#[test]
+fn a_pass_hands_its_front_to_the_next() {
+    struct HalfSpace;
+    impl RegionFilter for HalfSpace {
+        fn point_ok(&self, p: P3) -> bool {
+            p[0] < 0.1
+        }
+    }
+    let s = generate::icosphere([0.0; 3], 1.0, 3);
+    let field = |_p: P3| 0.15;
+    let pass = FrontOptions {
+        pass: true,
+        ..FrontOptions::default()
+    };
+    // The part sees the whole front, so nothing it makes can cross a face
+    // it may not advance; the filter holds those back (§7).
+    let faces: Vec<[u32; 3]> = s.tris.iter().map(|t| [t[0], t[2], t[1]]).collect();
+    let r1 = advance(
+        FrontInput {
+            points: s.points.clone(),
+            point_size: s.mean_edge_lengths(),
+            faces,
+        },
+        SizeMode::Field(&field),
+        &HalfSpace,
+        &pass,
+    )
+    .expect("an open front is allowed in a pass");
+    assert!(r1.tets.len() > 100, "pass 1 made {} tets", r1.tets.len());
+    for t in &r1.tets {
+        for &p in t {
+            assert!(r1.points[p as usize][0] < 0.1, "pass 1 left its region");
+        }
+    }
+    let rest = r1.front.clone();
+    let r2 = advance(
+        FrontInput {
+            points: r1.points.clone(),
+            point_size: r1.point_size.clone(),
+            faces: rest,
+        },
+        SizeMode::Field(&field),
+        &Everywhere,
+        &FrontOptions::default(),
+    )
+    .expect("the remaining front is closed and closes");
+    assert!(r2.front.is_empty());
+    let mut m = TetMesh {
+        points: r2.points,
+        tets: r1.tets.iter().chain(&r2.tets).map(|t| t.map(PointId)).collect(),
+        region: vec![0; r1.tets.len() + r2.tets.len()],
+        ..Default::default()
+    };
+    m.build_adjacency().unwrap();
+    m.check_against_surface(&s.tris)
+        .unwrap_or_else(|e| panic!("invalid mesh: {e}"));
+}

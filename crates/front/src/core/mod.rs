@@ -41,6 +41,14 @@ pub struct FrontOptions {
     pub progress_every: usize,
     /// Where to report it.
     pub progress: Option<std::sync::Arc<crate::Progress>>,
+    /// A parallel pass (§7): the input front may be open (a part's share
+    /// of the global front), and faces that get stuck are handed back in
+    /// `FrontResult::front` for a later pass instead of being recovered.
+    /// The front handed over must still contain every face that bounds the
+    /// region (faces the filter rejects are held, not advanced): the front
+    /// never crosses a face it does not know, and an open front bounds
+    /// nothing.
+    pub pass: bool,
 }
 
 impl Default for FrontOptions {
@@ -51,6 +59,7 @@ impl Default for FrontOptions {
             max_points: u32::MAX as usize - 1,
             progress_every: 4096,
             progress: None,
+            pass: false,
         }
     }
 }
@@ -85,7 +94,8 @@ pub struct FrontResult {
     pub tets: Vec<[u32; 4]>,
     /// `neigh[4t+f] = 4t'+f'` or `u32::MAX`.
     pub neigh: Vec<u32>,
-    /// Faces the region filter kept from being advanced (pass hand-over).
+    /// Faces the region filter kept from being advanced, and in pass mode
+    /// the faces that got stuck (pass hand-over).
     pub front: Vec<[u32; 3]>,
     pub stats: FrontStats,
 }
@@ -335,7 +345,9 @@ pub fn advance(
     region: &dyn RegionFilter,
     opts: &FrontOptions,
 ) -> Result<FrontResult, FrontError> {
-    check_closed(&input.faces)?;
+    if !opts.pass {
+        check_closed(&input.faces)?;
+    }
     let n = input.points.len();
     let bb = Aabb::from_points(&input.points);
     let hmin = input
@@ -515,6 +527,11 @@ impl<'a> Front<'a> {
             }
             self.stuck.retain(|&f| self.falive[f as usize]);
             if self.stuck.is_empty() {
+                return Ok(());
+            }
+            if self.opts.pass {
+                // §7: what a pass cannot close goes to the next pass.
+                self.prohibited.append(&mut self.stuck);
                 return Ok(());
             }
             // Give up early when recovery stops making headway, rather than
