@@ -401,8 +401,9 @@ pub fn advance(
     Ok(f.finish())
 }
 
-/// Every directed edge of a closed front appears exactly once, and its
-/// reverse once.
+/// A closed front uses every edge as often in one direction as in the
+/// other. A front handed over by a pass may touch itself along an edge
+/// (four faces), so counts above one are allowed.
 fn check_closed(faces: &[[u32; 3]]) -> Result<(), FrontError> {
     let mut e: Vec<(u32, u32)> = Vec::with_capacity(faces.len() * 3);
     for v in faces {
@@ -411,6 +412,11 @@ fn check_closed(faces: &[[u32; 3]]) -> Result<(), FrontError> {
         }
     }
     e.sort_unstable();
+    let count = |x: (u32, u32)| {
+        let lo = e.partition_point(|y| *y < x);
+        let hi = e.partition_point(|y| *y <= x);
+        hi - lo
+    };
     let mut i = 0;
     while i < e.len() {
         let mut j = i + 1;
@@ -418,8 +424,7 @@ fn check_closed(faces: &[[u32; 3]]) -> Result<(), FrontError> {
             j += 1;
         }
         let (a, b) = e[i];
-        let rev = e.binary_search(&(b, a)).is_ok();
-        if j - i > 1 || !rev {
+        if count((b, a)) != j - i {
             return Err(FrontError::OpenFront { a, b, count: j - i });
         }
         i = j;
@@ -432,10 +437,10 @@ impl<'a> Front<'a> {
         // AF1: the face forming the smallest element goes first.
         let h = (self.hp[v[0] as usize] + self.hp[v[1] as usize] + self.hp[v[2] as usize]) / 3.0;
         let p = |i: usize| self.pts[v[i] as usize];
-        let e = dist2(p(0), p(1))
-            .max(dist2(p(1), p(2)))
-            .max(dist2(p(2), p(0)))
-            .sqrt();
+        // The edge of an equilateral triangle of the same area: a needle
+        // goes first, while the room above it is still free.
+        let a2 = norm(tri_normal(p(0), p(1), p(2)));
+        let e = (a2 * (2.0 / 3f64.sqrt())).sqrt();
         h.min(e)
     }
 
@@ -529,8 +534,10 @@ impl<'a> Front<'a> {
             if self.stuck.is_empty() {
                 return Ok(());
             }
-            if self.opts.pass {
-                // §7: what a pass cannot close goes to the next pass.
+            if self.opts.pass && self.relax >= 1 {
+                // §7: what a pass cannot close goes to the next pass, after
+                // one round of removal and re-meshing, so that it hands over
+                // no worse a front than it could make.
                 self.prohibited.append(&mut self.stuck);
                 return Ok(());
             }
@@ -626,6 +633,10 @@ impl<'a> Front<'a> {
     /// Every face of the front gets another go, relaxed.
     fn requeue_front(&mut self) {
         self.stuck.clear();
+        // Every live face is queued again, once (faces the removal just
+        // added are queued already); held ones are held again.
+        self.heap.clear();
+        self.prohibited.clear();
         for id in 0..self.fv.len() {
             if self.falive[id] {
                 self.ftries[id] = 0;
@@ -847,6 +858,15 @@ impl<'a> Front<'a> {
             let gp = g.map(|i| self.pts[i as usize]);
             let gl = g.map(|x| tv.iter().position(|&y| y == x).unwrap_or(4));
             let apart = planes.separates(&gp, gl);
+            // The apex keeps clear of front faces too, not only of front
+            // points: a long face has its corners far away, and a tet that
+            // hovers over its middle leaves a slab only slivers can fill.
+            if margin > 0.0
+                && !g.contains(&q)
+                && point_triangle_dist2(pq, gp[0], gp[1], gp[2]) < margin * margin
+            {
+                return false;
+            }
             for lf in &new_faces {
                 let fvid = lf.map(|k| tv[k]);
                 let shared = fvid.iter().filter(|x| g.contains(x)).count();
