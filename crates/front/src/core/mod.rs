@@ -401,9 +401,9 @@ pub fn advance(
     Ok(f.finish())
 }
 
-/// A closed front uses every edge as often in one direction as in the
-/// other. A front handed over by a pass may touch itself along an edge
-/// (four faces), so counts above one are allowed.
+/// Every directed edge of a closed front appears as often as its reverse.
+/// Once each is the usual case; a front left by parallel passes (§7) may
+/// pinch, two gaps touching along an edge, and then uses it twice each way.
 fn check_closed(faces: &[[u32; 3]]) -> Result<(), FrontError> {
     let mut e: Vec<(u32, u32)> = Vec::with_capacity(faces.len() * 3);
     for v in faces {
@@ -412,11 +412,6 @@ fn check_closed(faces: &[[u32; 3]]) -> Result<(), FrontError> {
         }
     }
     e.sort_unstable();
-    let count = |x: (u32, u32)| {
-        let lo = e.partition_point(|y| *y < x);
-        let hi = e.partition_point(|y| *y <= x);
-        hi - lo
-    };
     let mut i = 0;
     while i < e.len() {
         let mut j = i + 1;
@@ -424,7 +419,9 @@ fn check_closed(faces: &[[u32; 3]]) -> Result<(), FrontError> {
             j += 1;
         }
         let (a, b) = e[i];
-        if count((b, a)) != j - i {
+        let lo = e.partition_point(|x| *x < (b, a));
+        let hi = e.partition_point(|x| *x <= (b, a));
+        if hi - lo != j - i {
             return Err(FrontError::OpenFront { a, b, count: j - i });
         }
         i = j;
