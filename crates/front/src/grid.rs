@@ -30,13 +30,14 @@ pub struct LooseGrid {
     s0: f64,
     origin: P3,
     levels: Vec<Level>,
-    // Per item id: its level, cell key, list links, centre, half extent.
+    // Per item id: its level, cell key, list links. No centre: the caller
+    // filters exactly anyway, and 24 bytes per face id was a third of the
+    // front's memory.
     lvl: Vec<u8>,
     key: Vec<u64>,
     next: Vec<u32>,
     prev: Vec<u32>,
     pos: Vec<u32>,
-    centre: Vec<P3>,
     len: usize,
     /// Bit `k` set: level `k` holds items (queries skip the rest).
     used: u64,
@@ -70,7 +71,6 @@ impl LooseGrid {
             next: Vec::new(),
             prev: Vec::new(),
             pos: Vec::new(),
-            centre: Vec::new(),
             len: 0,
             used: 0,
         }
@@ -114,7 +114,6 @@ impl LooseGrid {
             self.next.resize(n, NIL);
             self.prev.resize(n, NIL);
             self.pos.resize(n, NIL);
-            self.centre.resize(n, [0.0; 3]);
         }
         debug_assert!(self.lvl[i] == u8::MAX, "item {id} inserted twice");
         let k = self.level_for(extent);
@@ -132,7 +131,6 @@ impl LooseGrid {
         self.lvl[i] = k as u8;
         self.used |= 1 << k;
         self.key[i] = key;
-        self.centre[i] = c;
         self.len += 1;
     }
 
@@ -183,9 +181,7 @@ impl LooseGrid {
                 * (hi[2] - lo[2] + 1) as f64;
             if ncell > lv.items.len() as f64 || ncell > (1u64 << 40) as f64 {
                 for &id in &lv.items {
-                    if qq.contains(self.centre[id as usize]) {
-                        f(id);
-                    }
+                    f(id);
                 }
                 continue;
             }
@@ -195,10 +191,8 @@ impl LooseGrid {
                         if let Some(&h) = lv.heads.get(&cell_key([x, y, z])) {
                             let mut id = h;
                             while id != NIL {
-                                // Wrapped keys can alias: filter by centre.
-                                if qq.contains(self.centre[id as usize]) {
-                                    f(id);
-                                }
+                                // Wrapped keys can alias: the caller filters.
+                                f(id);
                                 id = self.next[id as usize];
                             }
                         }

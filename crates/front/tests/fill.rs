@@ -126,7 +126,12 @@ fn a_pass_hands_its_front_to_the_next() {
     assert!(r2.front.is_empty());
     let mut m = TetMesh {
         points: r2.points,
-        tets: r1.tets.iter().chain(&r2.tets).map(|t| t.map(PointId)).collect(),
+        tets: r1
+            .tets
+            .iter()
+            .chain(&r2.tets)
+            .map(|t| t.map(PointId))
+            .collect(),
         region: vec![0; r1.tets.len() + r2.tets.len()],
         ..Default::default()
     };

@@ -139,7 +139,9 @@ struct Front<'a> {
     fowner: Vec<u32>,
     ftries: Vec<u8>,
     fmap: FxHashMap<[u32; 3], u32>,
-    heap: BinaryHeap<Reverse<(u64, u32)>>,
+    /// AF1's queue: `key << 32 | face`, the key an `f32` size (positive
+    /// floats order as their bits), so one entry is 8 bytes.
+    heap: BinaryHeap<Reverse<u64>>,
     fgrid: LooseGrid,
     tets: Vec<[u32; 4]>,
     neigh: Vec<u32>,
@@ -330,6 +332,11 @@ impl SeparatingPlanes {
     }
 }
 
+#[inline]
+fn heap_entry(key: f64, face: u32) -> Reverse<u64> {
+    Reverse(((key as f32).to_bits() as u64) << 32 | face as u64)
+}
+
 fn tri_box(p: &[P3], v: [u32; 3]) -> Aabb {
     let mut b = Aabb::EMPTY;
     for &i in &v {
@@ -452,7 +459,7 @@ impl<'a> Front<'a> {
         let ext = (0..3).map(|k| bb.max[k] - bb.min[k]).fold(0.0, f64::max);
         self.fgrid.insert(id, bb.center(), ext);
         let key = self.face_key(v);
-        self.heap.push(Reverse((key.to_bits(), id)));
+        self.heap.push(heap_entry(key, id));
     }
 
     fn remove_face(&mut self, id: u32) {
@@ -502,7 +509,8 @@ impl<'a> Front<'a> {
         let mut fewest_stuck = usize::MAX;
         let mut last_gain = 0;
         loop {
-            while let Some(Reverse((key, fid))) = self.heap.pop() {
+            while let Some(Reverse(e)) = self.heap.pop() {
+                let (key, fid) = (f32::from_bits((e >> 32) as u32) as f64, e as u32);
                 if !self.falive[fid as usize] {
                     continue;
                 }
@@ -519,8 +527,7 @@ impl<'a> Front<'a> {
                         *t += 1;
                         if *t < self.opts.tries_per_face {
                             // Later, when its surroundings have changed.
-                            let k = f64::from_bits(key) * 1.5;
-                            self.heap.push(Reverse((k.to_bits(), fid)));
+                            self.heap.push(heap_entry(key * 1.5, fid));
                         } else {
                             self.stuck.push(fid);
                         }
@@ -638,7 +645,7 @@ impl<'a> Front<'a> {
             if self.falive[id] {
                 self.ftries[id] = 0;
                 let key = self.face_key(self.fv[id]);
-                self.heap.push(Reverse((key.to_bits(), id as u32)));
+                self.heap.push(heap_entry(key, id as u32));
             }
         }
     }
@@ -967,11 +974,23 @@ impl<'a> Front<'a> {
 
     /// Drop dead tets and unused new points; input points keep their ids.
     fn finish(self) -> FrontResult {
-        let nt = self.tets.len();
+        // The search structures go first: the output is built in place, so
+        // the peak is the front's own.
+        drop((self.heap, self.fmap, self.fgrid, self.fowner, self.ftries));
+        drop((self.near_f, self.near_p, self.cands, self.stamp, self.stuck));
+        let front: Vec<[u32; 3]> = self
+            .prohibited
+            .iter()
+            .filter(|&&f| self.falive[f as usize])
+            .map(|&f| self.fv[f as usize])
+            .collect();
+        drop((self.fv, self.falive));
+        let (mut tets, mut neigh, talive) = (self.tets, self.neigh, self.talive);
+        let nt = tets.len();
         let mut tmap = vec![NONE; nt];
         let mut k = 0u32;
         for t in 0..nt {
-            if self.talive[t] {
+            if talive[t] {
                 tmap[t] = k;
                 k += 1;
             }
@@ -979,48 +998,49 @@ impl<'a> Front<'a> {
         let mut used = vec![false; self.pts.len()];
         used[..self.n_input].iter_mut().for_each(|u| *u = true);
         for t in 0..nt {
-            if self.talive[t] {
-                for &p in &self.tets[t] {
+            if talive[t] {
+                for &p in &tets[t] {
                     used[p as usize] = true;
                 }
             }
         }
-        let front: Vec<[u32; 3]> = self
-            .prohibited
-            .iter()
-            .filter(|&&f| self.falive[f as usize])
-            .map(|&f| self.fv[f as usize])
-            .collect();
         for f in &front {
             for &p in f {
                 used[p as usize] = true;
             }
         }
         let mut pmap = vec![NONE; self.pts.len()];
-        let mut points = Vec::new();
-        let mut point_size = Vec::new();
-        for (i, &u) in used.iter().enumerate() {
-            if u {
-                pmap[i] = points.len() as u32;
-                points.push(self.pts[i]);
-                point_size.push(self.hp[i]);
+        let (mut points, mut point_size) = (self.pts, self.hp);
+        let mut np = 0;
+        for i in 0..used.len() {
+            if used[i] {
+                pmap[i] = np as u32;
+                points[np] = points[i];
+                point_size[np] = point_size[i];
+                np += 1;
             }
         }
-        let mut tets = Vec::with_capacity(k as usize);
-        let mut neigh = Vec::with_capacity(4 * k as usize);
+        points.truncate(np);
+        point_size.truncate(np);
+        // Compact in place: slot k <= t is free when tet t moves there.
         for t in 0..nt {
-            if self.talive[t] {
-                tets.push(self.tets[t].map(|p| pmap[p as usize]));
-                for i in 0..4 {
-                    let nb = self.neigh[4 * t + i];
-                    neigh.push(if nb == NONE {
-                        NONE
-                    } else {
-                        4 * tmap[(nb >> 2) as usize] + (nb & 3)
-                    });
-                }
+            let j = tmap[t];
+            if j == NONE {
+                continue;
+            }
+            let j = j as usize;
+            tets[j] = tets[t].map(|p| pmap[p as usize]);
+            for i in 0..4 {
+                let nb = neigh[4 * t + i];
+                neigh[4 * j + i] = if nb == NONE {
+                    NONE
+                } else {
+                    4 * tmap[(nb >> 2) as usize] + (nb & 3)
+                };
             }
         }
+        tets.truncate(k as usize);
+        neigh.truncate(4 * k as usize);
         let mut stats = self.stats;
         stats.tets = tets.len();
         stats.new_points = points.len() - self.n_input;
