@@ -94,6 +94,10 @@ struct MeshArgs {
     /// Also plot the quality histograms to this file (.svg or .png).
     #[arg(long)]
     plot: Option<PathBuf>,
+    /// If the front cannot be closed, write what it made (tets) and the
+    /// faces it left (triangles) to this file (.vtu, .msh or .mesh).
+    #[arg(long)]
+    debug_dump: Option<PathBuf>,
 }
 
 #[derive(Args)]
@@ -199,6 +203,7 @@ fn mesh_options(a: &MeshArgs) -> Result<MeshOptions, Fail> {
         o.size.gradation = v;
     }
     o.threads = a.threads.unwrap_or(0);
+    o.debug_partial = a.debug_dump.is_some();
     Ok(o)
 }
 
@@ -230,10 +235,15 @@ fn run_mesh(s: &Surface, name: &str, out: &Path, a: &MeshArgs, w: &WriteArgs) ->
     let bar = ProgressLine::start(progress);
     let res = mesh_surface(s, &opts);
     bar.finish();
-    let (mesh, mut sum) = res.map_err(|e| match e {
-        MeshError::InvalidSurface(_) => Fail(1, format!("{name}: {e}")),
-        e => Fail(1, format!("{name}: {e}")),
-    })?;
+    let (mesh, mut sum) = match res {
+        Ok(r) => r,
+        Err(e) => {
+            if let (Some(path), MeshError::Front { source, .. }) = (&a.debug_dump, &e) {
+                write_partial(path, source, &wopts);
+            }
+            return Err(Fail(1, format!("{name}: {e}")));
+        }
+    };
     let t0 = Instant::now();
     write_mesh(out, &mesh, &wopts)?;
     sum.stages.push(("write", t0.elapsed().as_secs_f64()));
@@ -245,6 +255,42 @@ fn run_mesh(s: &Surface, name: &str, out: &Path, a: &MeshArgs, w: &WriteArgs) ->
         println!("wrote {}", p.display());
     }
     Ok(())
+}
+
+/// The debug dump of a failed front: its tets, and the faces it left as
+/// triangles. A failure to write it is reported, not fatal.
+fn write_partial(path: &Path, e: &parafront_front::FrontError, w: &WriteOptions) {
+    let parafront_front::FrontError::Stuck {
+        partial: Some(p), ..
+    } = e
+    else {
+        return;
+    };
+    let mesh = parafront_mesh::TetMesh {
+        points: p.points.clone(),
+        tets: p
+            .tets
+            .iter()
+            .map(|t| t.map(parafront_mesh::PointId))
+            .collect(),
+        region: vec![0; p.tets.len()],
+        bnd_tris: p
+            .front
+            .iter()
+            .map(|f| f.map(parafront_mesh::PointId))
+            .collect(),
+        bnd_patch: vec![0; p.front.len()],
+        ..Default::default()
+    };
+    match write_mesh(path, &mesh, w) {
+        Ok(()) => eprintln!(
+            "wrote the partial mesh ({} tets) and the stuck front ({} triangles) to {}",
+            p.tets.len(),
+            p.front.len(),
+            path.display()
+        ),
+        Err(err) => eprintln!("could not write the debug dump {}: {err}", path.display()),
+    }
 }
 
 /// The front's progress on a terminal: tets made, front size, rate.

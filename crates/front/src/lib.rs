@@ -13,7 +13,9 @@ mod core;
 pub mod grid;
 mod quality;
 
-pub use crate::core::{advance, FrontError, FrontInput, FrontOptions, FrontResult, FrontStats};
+pub use crate::core::{
+    advance, FrontError, FrontInput, FrontOptions, FrontResult, FrontStats, Partial,
+};
 
 use std::sync::atomic::{AtomicU64, Ordering};
 

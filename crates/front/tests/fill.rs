@@ -139,3 +139,66 @@ fn a_pass_hands_its_front_to_the_next() {
     m.check_against_surface(&s.tris)
         .unwrap_or_else(|e| panic!("invalid mesh: {e}"));
 }
+
+/// Step 5.4: a front that gives up hands back what it made, and that is
+/// consistent: the tets' open faces are the input faces it never covered
+/// plus exactly the faces it left in the front.
+#[test]
+fn a_failed_front_hands_back_its_partial_mesh() {
+    let s = generate::torus([0.0; 3], 2.0, 0.6, 32, 12);
+    let field = |_p: P3| 0.3;
+    let opts = FrontOptions {
+        recovery_rounds: 0,
+        keep_partial: true,
+        ..FrontOptions::default()
+    };
+    let input: Vec<[u32; 3]> = s.tris.iter().map(|t| [t[0], t[2], t[1]]).collect();
+    let err = advance(
+        FrontInput {
+            points: s.points.clone(),
+            point_size: s.mean_edge_lengths(),
+            faces: input.clone(),
+        },
+        SizeMode::Field(&field),
+        &Everywhere,
+        &opts,
+    )
+    .expect_err("no recovery: this torus gets stuck in the first pass");
+    let FrontError::Stuck {
+        faces,
+        partial: Some(p),
+        ..
+    } = err
+    else {
+        panic!("expected Stuck with a partial mesh, got {err}");
+    };
+    assert!(!p.tets.is_empty() && !p.front.is_empty());
+    assert_eq!(p.front.len(), faces);
+    let sorted = |mut f: [u32; 3]| {
+        f.sort_unstable();
+        f
+    };
+    // Faces used once by the tets, with the input faces they cover removed.
+    let mut count = std::collections::HashMap::new();
+    for t in &p.tets {
+        for f in parafront_mesh::TET_FACES {
+            *count.entry(sorted(f.map(|k| t[k]))).or_insert(0) += 1;
+        }
+    }
+    let mut open: std::collections::HashSet<[u32; 3]> = count
+        .into_iter()
+        .filter(|e| e.1 == 1)
+        .map(|e| e.0)
+        .collect();
+    let mut uncovered = Vec::new();
+    for f in &input {
+        if !open.remove(&sorted(*f)) {
+            uncovered.push(sorted(*f));
+        }
+    }
+    let mut expect: Vec<[u32; 3]> = open.into_iter().chain(uncovered).collect();
+    let mut got: Vec<[u32; 3]> = p.front.iter().map(|f| sorted(*f)).collect();
+    expect.sort_unstable();
+    got.sort_unstable();
+    assert_eq!(got, expect);
+}

@@ -30,6 +30,10 @@ pub struct MeshOptions {
     /// Skip the final validity check (not recommended; it is cheap).
     #[serde(default)]
     pub no_check: bool,
+    /// When the front fails, keep its partial mesh and stuck faces in the
+    /// error, for a debug dump (`parafront mesh --debug-dump`).
+    #[serde(default)]
+    pub debug_partial: bool,
     /// Counters the front updates, for a progress display (not an option
     /// a file can set).
     #[serde(skip)]
@@ -117,6 +121,7 @@ pub fn mesh_surface(s: &Surface, opts: &MeshOptions) -> Result<(TetMesh, Summary
             &parafront_front::Everywhere,
             &FrontOptions {
                 progress: opts.progress.clone(),
+                keep_partial: opts.debug_partial,
                 ..FrontOptions::default()
             },
         )

@@ -49,6 +49,9 @@ pub struct FrontOptions {
     /// never crosses a face it does not know, and an open front bounds
     /// nothing.
     pub pass: bool,
+    /// On failure, hand back the partial mesh and the stuck front in
+    /// `FrontError::Stuck` (issue 3, step 5.4: a debug dump when asked).
+    pub keep_partial: bool,
 }
 
 impl Default for FrontOptions {
@@ -60,6 +63,7 @@ impl Default for FrontOptions {
             progress_every: 4096,
             progress: None,
             pass: false,
+            keep_partial: false,
         }
     }
 }
@@ -100,6 +104,15 @@ pub struct FrontResult {
     pub stats: FrontStats,
 }
 
+/// What the front had made when it gave up: its points, its tets and the
+/// faces still in the front, in one numbering.
+#[derive(Debug, Default)]
+pub struct Partial {
+    pub points: Vec<P3>,
+    pub tets: Vec<[u32; 4]>,
+    pub front: Vec<[u32; 3]>,
+}
+
 #[derive(Debug, thiserror::Error)]
 pub enum FrontError {
     #[error("the front could not be closed after {rounds} recovery rounds: {faces} faces stuck near ({x:.6e}, {y:.6e}, {z:.6e})")]
@@ -109,6 +122,8 @@ pub enum FrontError {
         x: f64,
         y: f64,
         z: f64,
+        /// With `FrontOptions::keep_partial`.
+        partial: Option<Box<Partial>>,
     },
     #[error(
         "the front is not closed: edge ({a}, {b}) is used by {count} faces with this direction"
@@ -559,12 +574,26 @@ impl<'a> Front<'a> {
                     self.pts[v[1] as usize],
                     self.pts[v[2] as usize],
                 );
+                let partial = self.opts.keep_partial.then(|| {
+                    Box::new(Partial {
+                        points: self.pts.clone(),
+                        tets: (0..self.tets.len())
+                            .filter(|&t| self.talive[t])
+                            .map(|t| self.tets[t])
+                            .collect(),
+                        front: (0..self.fv.len())
+                            .filter(|&f| self.falive[f])
+                            .map(|f| self.fv[f])
+                            .collect(),
+                    })
+                });
                 return Err(FrontError::Stuck {
                     rounds: self.relax,
                     faces: self.stuck.len(),
                     x: c[0],
                     y: c[1],
                     z: c[2],
+                    partial,
                 });
             }
             self.recover();
