@@ -91,9 +91,14 @@ struct MeshArgs {
     /// Worker threads (default: all cores).
     #[arg(long)]
     threads: Option<usize>,
-    /// Also plot the quality histograms to this file (.svg or .png).
+    /// Also plot the quality histograms to this file (.svg or .png);
+    /// with improvement on, before and after.
     #[arg(long)]
     plot: Option<PathBuf>,
+    /// Mesh improvement level (§9): 0 off, 1 swaps and smoothing, 2
+    /// (default) also edge collapse and selective movement, 3 more passes.
+    #[arg(long)]
+    optimize: Option<u8>,
 }
 
 #[derive(Args)]
@@ -199,6 +204,9 @@ fn mesh_options(a: &MeshArgs) -> Result<MeshOptions, Fail> {
         o.size.gradation = v;
     }
     o.threads = a.threads.unwrap_or(0);
+    if let Some(l) = a.optimize {
+        o.optimize = l;
+    }
     Ok(o)
 }
 
@@ -241,7 +249,7 @@ fn run_mesh(s: &Surface, name: &str, out: &Path, a: &MeshArgs, w: &WriteArgs) ->
     print_summary(&sum, &q);
     println!("wrote {}", out.display());
     if let Some(p) = &a.plot {
-        plot::plot_histograms(&q, None, p)?;
+        plot::plot_histograms(&q, sum.quality_before.as_ref(), p)?;
         println!("wrote {}", p.display());
     }
     Ok(())
@@ -326,6 +334,28 @@ fn print_summary(sum: &Summary, q: &QualityReport) {
             "peak memory: {:.1} MiB ({:.0} bytes/tet)",
             m as f64 / 1048576.0,
             m as f64 / sum.tets.max(1) as f64
+        );
+    }
+    if let (Some(b), Some(st)) = (&sum.quality_before, &sum.improve) {
+        println!(
+            "before improvement: min dihedral {:.2} deg, {:.3}% of tets under 10 deg, mean radius ratio {:.3} ({} tets)",
+            b.min_dihedral.min,
+            100.0 * b.share_min_dihedral_below,
+            b.radius_ratio.mean,
+            st.tets_before
+        );
+        let ops: Vec<String> = st
+            .ops()
+            .iter()
+            .map(|(n, o)| format!("{n} {}/{} in {:.3} s", o.done, o.tried, o.seconds))
+            .collect();
+        println!(
+            "improvement: {} ({} 2-3, {} 3-2, {} edge removals, {} points removed)",
+            ops.join(", "),
+            st.swaps_23,
+            st.swaps_32,
+            st.edge_removals,
+            st.points_removed
         );
     }
     println!(
