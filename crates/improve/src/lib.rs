@@ -35,9 +35,10 @@ use work::Work;
 #[derive(Clone, Debug, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ImproveOptions {
-    /// 0: off. 1: swaps and two smoothing passes. 2 (default): also edge
-    /// collapse of very bad tets, more smoothing and selective movement.
-    /// 3: more passes and a higher bar for "bad".
+    /// 0: off. 1: swaps of tets with mean ratio below 0.4 and two
+    /// smoothing passes. 2 (default): swaps below 0.7, edge collapse of
+    /// tets below 0.1, three smoothing passes and selective movement.
+    /// 3: one more smoothing and one more selective pass.
     #[serde(default = "default_level")]
     pub level: u8,
 }
@@ -117,7 +118,10 @@ pub fn improve(
     let lv = opts.level.min(3);
     // Thresholds on the mean ratio: "bad" for swaps and movement, "very
     // bad" for collapse (§9.2 is a pre-smoothing cleaner).
-    let bad = [0.0, 0.3, 0.4, 0.5][lv as usize];
+    // Measured on sphere_1e5: swapping up to 0.7 lifts the mean radius
+    // ratio from 0.836 to 0.852 for twice the time; 0.9 costs 10x more
+    // and gains nothing.
+    let bad = [0.0, 0.4, 0.7, 0.7][lv as usize];
     let very_bad = 0.1;
     let smooth_passes = [0, 2, 3, 4][lv as usize];
     if lv >= 2 {
