@@ -7,7 +7,7 @@
 //! in floating point.
 use crate::quality::quality;
 use crate::work::{Work, MAX_RING};
-use parafront_geom::{orient3d, tet_volume6, P3};
+use parafront_geom::{cross, dist2, norm, orient3d, sub, tet_volume6, P3};
 use parafront_mesh::{PointId, TET_FACES};
 
 /// What a local operation did.
@@ -357,7 +357,27 @@ impl Work<'_> {
                 c[k] += q[k];
             }
         }
-        let c = c.map(|x| x / s.nb.len() as f64);
+        let lap = c.map(|x| x / s.nb.len() as f64);
+        // The mean of the points that would make each tet of the ball
+        // regular on its face opposite p: follows the local size where
+        // the plain Laplacian mean drifts in graded meshes.
+        let mut ideal = [0.0; 3];
+        for &t in ball {
+            let v = self.m.tets[t as usize];
+            let Some(k) = v.iter().position(|&x| x == p) else {
+                continue;
+            };
+            let [x, y, z] = TET_FACES[k].map(|l| self.m.points[v[l].idx()]);
+            let n = cross(sub(y, x), sub(z, x));
+            let nn = norm(n);
+            let l2 = (dist2(x, y) + dist2(y, z) + dist2(z, x)) / 3.0;
+            let h = (l2 * 2.0 / 3.0).sqrt();
+            for i in 0..3 {
+                // The face's normal points away from p.
+                ideal[i] += (x[i] + y[i] + z[i]) / 3.0 - n[i] / nn.max(f64::MIN_POSITIVE) * h;
+            }
+        }
+        let ideal = ideal.map(|x| x / ball.len() as f64);
         let p0 = self.m.points[p.idx()];
         let (qmin, qmean) = ball
             .iter()
@@ -365,7 +385,7 @@ impl Work<'_> {
             .fold((f64::INFINITY, 0.0), |(m, s), q| (m.min(q), s + q));
         let qmean = qmean / ball.len() as f64;
         let mut inverted = false;
-        for w in [1.0, 0.5, 0.25] {
+        for (c, w) in [(ideal, 1.0), (ideal, 0.5), (lap, 1.0), (lap, 0.5), (lap, 0.25)] {
             let pos = [0, 1, 2].map(|k| p0[k] + w * (c[k] - p0[k]));
             match self.ball_quality_at(p, pos, ball) {
                 None => inverted = true,

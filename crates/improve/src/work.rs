@@ -349,34 +349,50 @@ impl<'m> Work<'m> {
         true
     }
 
-    /// Drops dead tets and points, renumbering what is left in order
-    /// (surviving ids keep their relative order).
-    pub fn compact(self) {
+    /// Drops dead tets, and dead points when `drop_points`, renumbering
+    /// what is left in order (surviving ids keep their relative order).
+    /// Returns which points died.
+    pub fn compact(self, drop_points: bool) -> Vec<bool> {
         let m = self.m;
-        let nt = m.tets.len();
-        let mut tmap = vec![u32::MAX; nt];
-        let mut k = 0u32;
-        for t in 0..nt {
-            if m.tets[t] != DEAD {
-                tmap[t] = k;
-                k += 1;
-            }
+        if !drop_points {
+            let keep = vec![false; m.points.len()];
+            compact_arrays(m, &keep);
+            return self.dead_pt;
         }
-        let mut pmap = vec![u32::MAX; m.points.len()];
-        let mut kp = 0u32;
-        for (p, d) in self.dead_pt.iter().enumerate() {
-            if !d {
-                pmap[p] = kp;
-                kp += 1;
-            }
+        compact_arrays(m, &self.dead_pt);
+        self.dead_pt
+    }
+}
+
+/// Drops the dead tet slots and the points marked in `dead_pt`,
+/// renumbering tets, neighbours (when built) and boundary triangles.
+pub(crate) fn compact_arrays(m: &mut TetMesh, dead_pt: &[bool]) {
+    let nt = m.tets.len();
+    let has_neigh = m.neigh.len() == 4 * nt;
+    let mut tmap = vec![u32::MAX; nt];
+    let mut k = 0u32;
+    for t in 0..nt {
+        if m.tets[t] != DEAD {
+            tmap[t] = k;
+            k += 1;
         }
-        let mut w = 0;
-        for t in 0..nt {
-            if tmap[t] == u32::MAX {
-                continue;
-            }
-            m.tets[w] = m.tets[t].map(|p| PointId(pmap[p.idx()]));
-            m.region[w] = m.region[t];
+    }
+    let mut pmap = vec![u32::MAX; m.points.len()];
+    let mut kp = 0u32;
+    for p in 0..m.points.len() {
+        if !dead_pt.get(p).copied().unwrap_or(false) {
+            pmap[p] = kp;
+            kp += 1;
+        }
+    }
+    let mut w = 0;
+    for t in 0..nt {
+        if tmap[t] == u32::MAX {
+            continue;
+        }
+        m.tets[w] = m.tets[t].map(|p| PointId(pmap[p.idx()]));
+        m.region[w] = m.region[t];
+        if has_neigh {
             for f in 0..4 {
                 let n = m.neigh[4 * t + f];
                 m.neigh[4 * w + f] = if n.is_none() {
@@ -385,21 +401,25 @@ impl<'m> Work<'m> {
                     FaceRef(tmap[n.tet().idx()] * 4 + n.local() as u32)
                 };
             }
-            w += 1;
         }
-        m.tets.truncate(w);
-        m.region.truncate(w);
+        w += 1;
+    }
+    m.tets.truncate(w);
+    m.region.truncate(w);
+    if has_neigh {
         m.neigh.truncate(4 * w);
-        let mut wp = 0;
-        for p in 0..m.points.len() {
-            if !self.dead_pt[p] {
-                m.points[wp] = m.points[p];
-                wp += 1;
-            }
+    } else {
+        m.neigh.clear();
+    }
+    let mut wp = 0;
+    for p in 0..m.points.len() {
+        if pmap[p] != u32::MAX {
+            m.points[wp] = m.points[p];
+            wp += 1;
         }
-        m.points.truncate(wp);
-        for t in &mut m.bnd_tris {
-            *t = t.map(|p| PointId(pmap[p.idx()]));
-        }
+    }
+    m.points.truncate(wp);
+    for t in &mut m.bnd_tris {
+        *t = t.map(|p| PointId(pmap[p.idx()]));
     }
 }

@@ -51,6 +51,7 @@ proptest! {
     fn improving_a_perturbed_box_keeps_it_valid(
         d in prop::collection::vec(prop::array::uniform3(-0.45f64..0.45), 27),
         level in 1u8..=3,
+        parts in 1usize..=3,
     ) {
         let m0 = perturbed(&d);
         let tris = |m: &TetMesh| -> Vec<[u32; 3]> {
@@ -59,7 +60,7 @@ proptest! {
         m0.check_against_surface(&tris(&m0)).unwrap();
         let vol0 = 1.0;
         let mut m = m0.clone();
-        let st = improve(&mut m, &[], &ImproveOptions { level }).unwrap();
+        let st = improve(&mut m, &[], &ImproveOptions { level, parts }).unwrap();
         m.check_against_surface(&tris(&m)).unwrap();
         prop_assert!(positive(&m));
         let vol: f64 = m.tets.iter().map(|t| {
@@ -76,7 +77,7 @@ proptest! {
         prop_assert_eq!(coords(&m), coords(&m0));
         prop_assert_eq!(st.tets_after, m.tets.len());
         let mut again = m0.clone();
-        improve(&mut again, &[], &ImproveOptions { level }).unwrap();
+        improve(&mut again, &[], &ImproveOptions { level, parts }).unwrap();
         prop_assert_eq!(&again.tets, &m.tets);
         prop_assert_eq!(&again.points, &m.points);
     }

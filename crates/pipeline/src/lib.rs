@@ -175,6 +175,7 @@ pub fn mesh_surface(s: &Surface, opts: &MeshOptions) -> Result<(TetMesh, Summary
         let frozen = vec![true; s.points.len()];
         let io = parafront_improve::ImproveOptions {
             level: opts.optimize,
+            ..Default::default()
         };
         let st = parafront_improve::improve(&mut mesh, &frozen, &io)
             .map_err(|e| MeshError::Topology(e.to_string()))?;
