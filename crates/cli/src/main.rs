@@ -60,6 +60,10 @@ enum Cmd {
         mesh: PathBuf,
         #[arg(long)]
         plot: Option<PathBuf>,
+        /// A mesh to compare with (e.g. the same run with --optimize 0):
+        /// its summary is printed and its histograms drawn behind.
+        #[arg(long)]
+        before: Option<PathBuf>,
     },
     /// Convert a tet mesh between formats (.vtu, .msh, .mesh).
     Convert {
@@ -155,7 +159,9 @@ fn main() -> ExitCode {
             .map_err(Fail::from)
             .and_then(|s| run_mesh(&s, &surface.display().to_string(), &output, &mesh, &write)),
         Cmd::Check { surface } => run_check(&surface),
-        Cmd::Quality { mesh, plot } => run_quality(&mesh, plot.as_deref()),
+        Cmd::Quality { mesh, plot, before } => {
+            run_quality(&mesh, plot.as_deref(), before.as_deref())
+        }
         Cmd::Convert {
             input,
             output,
@@ -415,7 +421,7 @@ fn run_check(path: &Path) -> Result<(), Fail> {
     }
 }
 
-fn run_quality(path: &Path, plot_to: Option<&Path>) -> Result<(), Fail> {
+fn run_quality(path: &Path, plot_to: Option<&Path>, before: Option<&Path>) -> Result<(), Fail> {
     let mesh = read_mesh(path)?;
     if let Err(e) = mesh.check() {
         println!("warning: {}: {e}", path.display());
@@ -428,8 +434,25 @@ fn run_quality(path: &Path, plot_to: Option<&Path>) -> Result<(), Fail> {
         mesh.tets.len()
     );
     println!("{q}");
+    let qb = match before {
+        Some(b) => {
+            let qb = QualityReport::new(&read_mesh(b)?);
+            for (name, r) in [(b, &qb), (path, &q)] {
+                println!(
+                    "{}: {} tets, min dihedral {:.2} deg, {:.3}% of tets under 10 deg, mean radius ratio {:.3}",
+                    name.display(),
+                    r.n_tets,
+                    r.min_dihedral.min,
+                    100.0 * r.share_min_dihedral_below,
+                    r.radius_ratio.mean
+                );
+            }
+            Some(qb)
+        }
+        None => None,
+    };
     if let Some(p) = plot_to {
-        plot::plot_histograms(&q, None, p)?;
+        plot::plot_histograms(&q, qb.as_ref(), p)?;
         println!("wrote {}", p.display());
     }
     Ok(())

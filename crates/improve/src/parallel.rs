@@ -168,9 +168,16 @@ fn pass(
     st: &mut ImproveStats,
 ) -> Result<Vec<u32>, TopoError> {
     let mut groups: Vec<Vec<u32>> = vec![Vec::new(); parts];
+    let mut keep: Vec<u32> = Vec::new();
     for (t, &p) in part.iter().enumerate() {
-        groups[p as usize].push(t as u32);
+        if p == LEAVE {
+            keep.push(t as u32);
+        } else {
+            groups[p as usize].push(t as u32);
+        }
     }
+    let kept: Vec<[PointId; 4]> = keep.iter().map(|&t| mesh.tets[t as usize]).collect();
+    let kept_region: Vec<u32> = keep.iter().map(|&t| mesh.region[t as usize]).collect();
     let pieces: Vec<Piece> = groups
         .par_iter()
         .map(|g| cut(mesh, g, frozen, level))
@@ -197,11 +204,60 @@ fn pass(
         new_part.extend(std::iter::repeat_n(k as u32, pc.mesh.tets.len()));
         add(st, &pc.st);
     }
+    mesh.tets.extend_from_slice(&kept);
+    mesh.region.extend_from_slice(&kept_region);
+    new_part.extend(std::iter::repeat_n(LEAVE, kept.len()));
     Ok(new_part)
 }
 
+/// Part id of tets a pass leaves alone.
+const LEAVE: u32 = u32::MAX;
+
+/// Keeps the parts only of the tets within `layers` point-layers of a
+/// point that tets of two parts share (the interfaces of the pass that
+/// used `part`); the others are marked [`LEAVE`].
+fn near_interfaces(mesh: &TetMesh, part: &mut [u32], first: &[u32], layers: usize) {
+    let np = mesh.points.len();
+    let mut seen = vec![u32::MAX; np];
+    let mut near = vec![false; np];
+    for (t, v) in mesh.tets.iter().enumerate() {
+        for p in v {
+            let s = &mut seen[p.idx()];
+            if *s == u32::MAX {
+                *s = first[t];
+            } else if *s != first[t] {
+                near[p.idx()] = true;
+            }
+        }
+    }
+    let mut active: Vec<bool> = mesh
+        .tets
+        .iter()
+        .map(|v| v.iter().any(|p| near[p.idx()]))
+        .collect();
+    for _ in 0..layers {
+        for (t, v) in mesh.tets.iter().enumerate() {
+            if active[t] {
+                for p in v {
+                    near[p.idx()] = true;
+                }
+            }
+        }
+        for (t, v) in mesh.tets.iter().enumerate() {
+            active[t] |= v.iter().any(|p| near[p.idx()]);
+        }
+    }
+    for (t, a) in active.iter().enumerate() {
+        if !a {
+            part[t] = LEAVE;
+        }
+    }
+}
+
 /// §9.5: a parallel pass on `parts` parts, a shift by [`SHIFT_LAYERS`],
-/// a second pass; then the dead points go and the adjacency is rebuilt.
+/// a second pass over the tets near the first pass's interfaces (the rest
+/// was improved already); then the dead points go and the adjacency is
+/// rebuilt.
 pub(crate) fn improve_parts(
     mesh: &mut TetMesh,
     frozen: &[bool],
@@ -211,8 +267,10 @@ pub(crate) fn improve_parts(
 ) -> Result<(), TopoError> {
     let mut dead = vec![false; mesh.points.len()];
     let part = partition(mesh, parts);
-    let mut part = pass(mesh, frozen, level, &part, parts, &mut dead, st)?;
+    let first = pass(mesh, frozen, level, &part, parts, &mut dead, st)?;
+    let mut part = first.clone();
     shift_partition(mesh, &mut part, SHIFT_LAYERS);
+    near_interfaces(mesh, &mut part, &first, SHIFT_LAYERS + 1);
     pass(mesh, frozen, level, &part, parts, &mut dead, st)?;
     st.points_removed = dead.iter().filter(|&&d| d).count();
     crate::work::compact_arrays(mesh, &dead);
