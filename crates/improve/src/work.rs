@@ -24,6 +24,10 @@ pub(crate) struct Work<'m> {
     pub q: Vec<f64>,
     /// Tested and left alone by the swapper since it last changed (§9.1).
     pub tested: Vec<bool>,
+    /// Smoothing left the point where it was and nothing in its ball has
+    /// changed since: smoothing it again would decide the same (§9.1's
+    /// marking, applied to §9.3).
+    pub settled: Vec<bool>,
     free: Vec<u32>,
     stamp: Vec<u32>,
     gen: u32,
@@ -83,6 +87,7 @@ impl<'m> Work<'m> {
             dead_pt: vec![false; np],
             p2t,
             tested: vec![false; nt],
+            settled: vec![false; np],
             q,
             free: Vec::new(),
             stamp: vec![0; nt],
@@ -329,6 +334,7 @@ impl<'m> Work<'m> {
             }
             for p in new[i] {
                 self.p2t[p.idx()] = s as u32;
+                self.settled[p.idx()] = false;
             }
         }
         // Cavity points in no new tet: point them at an outer tet.
