@@ -314,6 +314,9 @@ impl<'m> Improver<'m> {
     /// removals is kept.
     fn swap_pass(&mut self, thr: f64, st: &mut ImproveStats) {
         let t0 = Instant::now();
+        // Marks hold within a pass (§9.1); smoothing in between may have
+        // changed a ring without touching the marked tet.
+        self.w.tested.iter_mut().for_each(|x| *x = false);
         for _round in 0..10 {
             let bad = self.bad_tets(thr, true);
             let mut changed = 0;

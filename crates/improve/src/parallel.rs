@@ -164,7 +164,7 @@ fn pass(
     level: u8,
     part: &[u32],
     parts: usize,
-    dead: &mut Vec<bool>,
+    dead: &mut [bool],
     st: &mut ImproveStats,
 ) -> Result<Vec<u32>, TopoError> {
     let mut groups: Vec<Vec<u32>> = vec![Vec::new(); parts];

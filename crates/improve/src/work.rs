@@ -329,6 +329,8 @@ impl<'m> Work<'m> {
                     self.m.neigh[4 * s + g] = n;
                     if !n.is_none() {
                         self.m.neigh[n.0 as usize] = me;
+                        // Its surroundings changed: worth testing again.
+                        self.tested[n.tet().idx()] = false;
                     }
                 }
             }
