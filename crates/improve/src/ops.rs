@@ -129,11 +129,8 @@ impl Work<'_> {
         s.dp.clear();
         s.dp.resize(N * N, (f64::INFINITY, 0));
         let (pa, pb) = (self.m.points[a.idx()], self.m.points[b.idx()]);
-        let r: [P3; N] = std::array::from_fn(|i| {
-            s.ring
-                .get(i)
-                .map_or([0.0; 3], |p| self.m.points[p.idx()])
-        });
+        let r: [P3; N] =
+            std::array::from_fn(|i| s.ring.get(i).map_or([0.0; 3], |p| self.m.points[p.idx()]));
         for len in 2..n {
             for i in 0..n - len {
                 let j = i + len;
@@ -388,7 +385,13 @@ impl Work<'_> {
             .fold((f64::INFINITY, 0.0), |(m, s), q| (m.min(q), s + q));
         let qmean = qmean / ball.len() as f64;
         let mut inverted = false;
-        for (c, w) in [(ideal, 1.0), (ideal, 0.5), (lap, 1.0), (lap, 0.5), (lap, 0.25)] {
+        for (c, w) in [
+            (ideal, 1.0),
+            (ideal, 0.5),
+            (lap, 1.0),
+            (lap, 0.5),
+            (lap, 0.25),
+        ] {
             let pos = [0, 1, 2].map(|k| p0[k] + w * (c[k] - p0[k]));
             match self.ball_quality_at(p, pos, ball) {
                 None => inverted = true,

@@ -122,7 +122,10 @@ fn cut(mesh: &TetMesh, tets: &[u32], frozen: &[bool], level: u8) -> Result<Piece
     let local = |p: PointId| PointId(global.binary_search(&p.0).unwrap_or(0) as u32);
     let mut sub = TetMesh {
         points: global.iter().map(|&p| mesh.points[p as usize]).collect(),
-        tets: tets.iter().map(|&t| mesh.tets[t as usize].map(local)).collect(),
+        tets: tets
+            .iter()
+            .map(|&t| mesh.tets[t as usize].map(local))
+            .collect(),
         region: tets.iter().map(|&t| mesh.region[t as usize]).collect(),
         ..Default::default()
     };

@@ -137,7 +137,8 @@ fn brute_best(pts: &[P3], n: usize, a: P3, b: P3) -> f64 {
         }
         (i + 1..j)
             .map(|k| {
-                let t = quality([pts[i], pts[k], pts[j], b]).min(quality([pts[i], pts[j], pts[k], a]));
+                let t =
+                    quality([pts[i], pts[k], pts[j], b]).min(quality([pts[i], pts[j], pts[k], a]));
                 t.min(rec(pts, a, b, i, k)).min(rec(pts, a, b, k, j))
             })
             .fold(f64::NEG_INFINITY, f64::max)
@@ -159,7 +160,11 @@ fn edge_removal_of_rings_of_five_and_six() {
         assert_eq!(m.tets.len(), 2 * n - 4, "n={n}");
         assert_same_domain(&m, &tr, vol);
         // The dynamic programme finds the optimal triangulation.
-        assert!((worst(&m) - best).abs() < 1e-12, "n={n}: {} vs {best}", worst(&m));
+        assert!(
+            (worst(&m) - best).abs() < 1e-12,
+            "n={n}: {} vs {best}",
+            worst(&m)
+        );
         assert!(!m.tets.iter().any(|t| t.contains(&d) && t.contains(&e)));
     }
 }
@@ -250,7 +255,10 @@ fn move_refused_when_it_would_invert() {
     let before = m.clone();
     let mut imp = Improver::new(&mut m, &[]).unwrap();
     // Past the dent point: the tets on the dent would turn inside out.
-    assert_eq!(imp.move_point(PointId(0), [0.5, 0.0, 0.0]), Outcome::Inverted);
+    assert_eq!(
+        imp.move_point(PointId(0), [0.5, 0.0, 0.0]),
+        Outcome::Inverted
+    );
     // Boundary points never move.
     assert_eq!(imp.move_point(PointId(4), [0.0, 0.0, 0.9]), Outcome::Frozen);
     assert_eq!(imp.smooth_point(PointId(4)), Outcome::Frozen);
