@@ -124,10 +124,12 @@ impl<'m> Work<'m> {
     pub fn ball(&mut self, p: PointId, out: &mut Vec<u32>) {
         out.clear();
         let t0 = self.p2t[p.idx()];
-        if t0 == u32::MAX {
+        // An empty ball makes every operation on p a no-op, never a walk
+        // from a tet that does not hold p.
+        if t0 == u32::MAX || !self.m.tets[t0 as usize].contains(&p) {
+            debug_assert!(t0 == u32::MAX, "p2t of {p} is stale");
             return;
         }
-        debug_assert!(self.m.tets[t0 as usize].contains(&p));
         self.gen = self.gen.wrapping_add(1);
         if self.gen == 0 {
             self.stamp.iter_mut().for_each(|s| *s = 0);
