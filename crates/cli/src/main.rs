@@ -60,6 +60,10 @@ enum Cmd {
         mesh: PathBuf,
         #[arg(long)]
         plot: Option<PathBuf>,
+        /// A mesh to compare with (e.g. the same run with --optimize 0):
+        /// its summary is printed and its histograms drawn behind.
+        #[arg(long)]
+        before: Option<PathBuf>,
     },
     /// Convert a tet mesh between formats (.vtu, .msh, .mesh).
     Convert {
@@ -91,13 +95,18 @@ struct MeshArgs {
     /// Worker threads (default: all cores).
     #[arg(long)]
     threads: Option<usize>,
-    /// Also plot the quality histograms to this file (.svg or .png).
+    /// Also plot the quality histograms to this file (.svg or .png);
+    /// with improvement on, before and after.
     #[arg(long)]
     plot: Option<PathBuf>,
     /// If the front cannot be closed, write what it made (tets) and the
     /// faces it left (triangles) to this file (.vtu, .msh or .mesh).
     #[arg(long)]
     debug_dump: Option<PathBuf>,
+    /// Mesh improvement level (§9): 0 off, 1 swaps and smoothing, 2
+    /// (default) also edge collapse and selective movement, 3 more passes.
+    #[arg(long)]
+    optimize: Option<u8>,
 }
 
 #[derive(Args)]
@@ -154,7 +163,9 @@ fn main() -> ExitCode {
             .map_err(Fail::from)
             .and_then(|s| run_mesh(&s, &surface.display().to_string(), &output, &mesh, &write)),
         Cmd::Check { surface } => run_check(&surface),
-        Cmd::Quality { mesh, plot } => run_quality(&mesh, plot.as_deref()),
+        Cmd::Quality { mesh, plot, before } => {
+            run_quality(&mesh, plot.as_deref(), before.as_deref())
+        }
         Cmd::Convert {
             input,
             output,
@@ -204,6 +215,9 @@ fn mesh_options(a: &MeshArgs) -> Result<MeshOptions, Fail> {
     }
     o.threads = a.threads.unwrap_or(0);
     o.debug_partial = a.debug_dump.is_some();
+    if let Some(l) = a.optimize {
+        o.optimize = l;
+    }
     Ok(o)
 }
 
@@ -251,7 +265,7 @@ fn run_mesh(s: &Surface, name: &str, out: &Path, a: &MeshArgs, w: &WriteArgs) ->
     print_summary(&sum, &q);
     println!("wrote {}", out.display());
     if let Some(p) = &a.plot {
-        plot::plot_histograms(&q, None, p)?;
+        plot::plot_histograms(&q, sum.quality_before.as_ref(), p)?;
         println!("wrote {}", p.display());
     }
     Ok(())
@@ -374,6 +388,28 @@ fn print_summary(sum: &Summary, q: &QualityReport) {
             m as f64 / sum.tets.max(1) as f64
         );
     }
+    if let (Some(b), Some(st)) = (&sum.quality_before, &sum.improve) {
+        println!(
+            "before improvement: min dihedral {:.2} deg, {:.3}% of tets under 10 deg, mean radius ratio {:.3} ({} tets)",
+            b.min_dihedral.min,
+            100.0 * b.share_min_dihedral_below,
+            b.radius_ratio.mean,
+            st.tets_before
+        );
+        let ops: Vec<String> = st
+            .ops()
+            .iter()
+            .map(|(n, o)| format!("{n} {}/{} in {:.3} s", o.done, o.tried, o.seconds))
+            .collect();
+        println!(
+            "improvement (seconds of CPU per operation, summed over parts): {} ({} 2-3, {} 3-2, {} edge removals, {} points removed)",
+            ops.join(", "),
+            st.swaps_23,
+            st.swaps_32,
+            st.edge_removals,
+            st.points_removed
+        );
+    }
     println!(
         "quality: min dihedral {:.2} deg, {:.3}% of tets under 10 deg, mean radius ratio {:.3}",
         q.min_dihedral.min,
@@ -431,7 +467,7 @@ fn run_check(path: &Path) -> Result<(), Fail> {
     }
 }
 
-fn run_quality(path: &Path, plot_to: Option<&Path>) -> Result<(), Fail> {
+fn run_quality(path: &Path, plot_to: Option<&Path>, before: Option<&Path>) -> Result<(), Fail> {
     let mesh = read_mesh(path)?;
     if let Err(e) = mesh.check() {
         println!("warning: {}: {e}", path.display());
@@ -444,8 +480,25 @@ fn run_quality(path: &Path, plot_to: Option<&Path>) -> Result<(), Fail> {
         mesh.tets.len()
     );
     println!("{q}");
+    let qb = match before {
+        Some(b) => {
+            let qb = QualityReport::new(&read_mesh(b)?);
+            for (name, r) in [(b, &qb), (path, &q)] {
+                println!(
+                    "{}: {} tets, min dihedral {:.2} deg, {:.3}% of tets under 10 deg, mean radius ratio {:.3}",
+                    name.display(),
+                    r.n_tets,
+                    r.min_dihedral.min,
+                    100.0 * r.share_min_dihedral_below,
+                    r.radius_ratio.mean
+                );
+            }
+            Some(qb)
+        }
+        None => None,
+    };
     if let Some(p) = plot_to {
-        plot::plot_histograms(&q, None, p)?;
+        plot::plot_histograms(&q, qb.as_ref(), p)?;
         println!("wrote {}", p.display());
     }
     Ok(())

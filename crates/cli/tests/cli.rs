@@ -206,3 +206,49 @@ fn demo_mesh_passes_meshcheck() {
     assert!(o.status.success());
     meshcheck(&vol, &surf);
 }
+
+/// `--optimize 0` switches improvement off; the default reports before and
+/// after, and `quality --before` compares the two meshes and plots both.
+#[test]
+fn optimize_flag_and_quality_before() {
+    let raw = tmp("demo_raw.vtu");
+    let imp = tmp("demo_improved.vtu");
+    let o = bin()
+        .args(["demo", "--optimize", "0", "-o"])
+        .arg(&raw)
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{text}");
+    assert!(!text.contains("before improvement"), "{text}");
+    let o = bin().args(["demo", "-o"]).arg(&imp).output().unwrap();
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{text}");
+    assert!(
+        text.contains("before improvement") && text.contains("swap"),
+        "{text}"
+    );
+    let plot = tmp("demo_before_after.svg");
+    let o = bin()
+        .arg("quality")
+        .arg(&imp)
+        .arg("--before")
+        .arg(&raw)
+        .arg("--plot")
+        .arg(&plot)
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{text}");
+    assert!(plot.exists());
+    // The share of tets under 10 degrees, before and after.
+    let share = |name: &Path| -> f64 {
+        let line = text
+            .lines()
+            .find(|l| l.starts_with(&*name.display().to_string()) && l.contains("under 10 deg"))
+            .unwrap_or_else(|| panic!("no summary line for {}:\n{text}", name.display()));
+        let s = line.split("deg, ").nth(1).unwrap();
+        s.split('%').next().unwrap().trim().parse().unwrap()
+    };
+    assert!(share(&imp) < share(&raw), "{text}");
+}

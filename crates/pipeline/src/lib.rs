@@ -17,7 +17,7 @@ use std::time::Instant;
 
 /// Every option of `parafront mesh`, with documented defaults. The CLI
 /// flags and a TOML file (`--config`) both map onto it.
-#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct MeshOptions {
     /// The size field (AG1): global `h`, `hmin`, `hmax`, `gradation`,
@@ -38,6 +38,28 @@ pub struct MeshOptions {
     /// a file can set).
     #[serde(skip)]
     pub progress: Option<std::sync::Arc<parafront_front::Progress>>,
+    /// Mesh improvement level (§9): 0 off, 1 swaps and smoothing, 2
+    /// (default) also collapse of very bad tets and selective movement, 3
+    /// more passes. See `parafront_improve::ImproveOptions`.
+    #[serde(default = "default_optimize")]
+    pub optimize: u8,
+}
+
+fn default_optimize() -> u8 {
+    parafront_improve::ImproveOptions::default().level
+}
+
+impl Default for MeshOptions {
+    fn default() -> Self {
+        MeshOptions {
+            size: SizeOptions::default(),
+            threads: 0,
+            no_check: false,
+            debug_partial: false,
+            progress: None,
+            optimize: default_optimize(),
+        }
+    }
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -64,6 +86,10 @@ pub struct Summary {
     pub stages: Vec<(&'static str, f64)>,
     pub recovery_rounds: u32,
     pub tets_removed: usize,
+    /// Quality of the front's mesh before improvement (when it ran).
+    pub quality_before: Option<QualityReport>,
+    /// What improvement did, per operation (when it ran).
+    pub improve: Option<parafront_improve::ImproveStats>,
 }
 
 impl Summary {
@@ -147,6 +173,21 @@ pub fn mesh_surface(s: &Surface, opts: &MeshOptions) -> Result<(TetMesh, Summary
         sum.tets_removed += res.stats.tets_removed;
     }
     sum.stages.push(("front", t0.elapsed().as_secs_f64()));
+
+    if opts.optimize > 0 {
+        sum.quality_before = Some(QualityReport::new(&mesh));
+        let t0 = Instant::now();
+        // The surface points (ids below s.points.len()) never move (§9.3).
+        let frozen = vec![true; s.points.len()];
+        let io = parafront_improve::ImproveOptions {
+            level: opts.optimize,
+            ..Default::default()
+        };
+        let st = parafront_improve::improve(&mut mesh, &frozen, &io)
+            .map_err(|e| MeshError::Topology(e.to_string()))?;
+        sum.improve = Some(st);
+        sum.stages.push(("improve", t0.elapsed().as_secs_f64()));
+    }
 
     let t0 = Instant::now();
     mesh.build_adjacency()

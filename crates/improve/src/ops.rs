@@ -1,0 +1,480 @@
+//! The local operations of §9: face swap 2-3 and edge removal (3-2 and
+//! n -> 2n-4, §9.1), edge collapse (§9.2), Laplacian smoothing with move
+//! rejection (§9.3) and selective movement along edges (§9.4). Each first
+//! evaluates a candidate without touching the mesh and keeps it only when
+//! the worst quality of the tets it makes beats the worst of those it
+//! replaces, and every new tet is positive under the exact predicate and
+//! in floating point.
+use crate::quality::quality;
+use crate::work::{Work, MAX_RING};
+use parafront_geom::{cross, dist2, norm, orient3d, sub, tet_volume6, P3};
+use parafront_mesh::{PointId, TET_FACES};
+
+/// What a local operation did.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Outcome {
+    /// The mesh changed.
+    Done,
+    /// Valid, but the worst quality would not improve.
+    NotBetter,
+    /// A new tet would be inverted or flat (exactly or in floating point).
+    Inverted,
+    /// The operation would cross a boundary or region interface, or the
+    /// edge's ring is too long.
+    Constrained,
+    /// A point that must stay would move or disappear.
+    Frozen,
+    /// Edge collapse: the link condition fails.
+    LinkCondition,
+    /// The ids do not name an edge, face or live point of the mesh.
+    NotFound,
+}
+
+/// A replacement the operations evaluate before committing it.
+#[derive(Default)]
+pub(crate) struct Cand {
+    pub old: Vec<u32>,
+    pub new: Vec<[PointId; 4]>,
+    pub qmin: f64,
+}
+
+/// Relative margin a change must beat the old worst quality by, so that
+/// operations never cycle.
+const MARGIN: f64 = 1e-3;
+
+#[inline]
+pub(crate) fn beats(new: f64, old: f64) -> bool {
+    new > old + MARGIN * old.abs() + 1e-12
+}
+
+#[inline]
+fn positive(p: [P3; 4]) -> bool {
+    tet_volume6(p[0], p[1], p[2], p[3]) > 0.0 && orient3d(p[0], p[1], p[2], p[3]) > 0.0
+}
+
+/// Scratch space for the operations, kept between calls.
+#[derive(Default)]
+pub(crate) struct Scratch {
+    pub tets: Vec<u32>,
+    pub ring: Vec<PointId>,
+    pub ball: Vec<u32>,
+    pub ball2: Vec<u32>,
+    pub nb: Vec<PointId>,
+    pub nb2: Vec<PointId>,
+    tq: Vec<f64>,
+    dp: Vec<(f64, u8)>,
+    stack: Vec<(u8, u8)>,
+}
+
+impl Work<'_> {
+    fn all_positive(&self, new: &[[PointId; 4]]) -> bool {
+        new.iter().all(|&v| positive(self.pts(v)))
+    }
+
+    /// §9.1 face swap 2-3: face `f` of `t` and the tet behind it become
+    /// three tets around the edge joining their apexes.
+    pub(crate) fn eval_23(&self, t: u32, f: usize, c: &mut Cand) -> Outcome {
+        let Some(n) = self.free_neighbour(t, f) else {
+            return Outcome::Constrained;
+        };
+        let v = self.m.tets[t as usize];
+        let d = v[f];
+        let [a, b, cc] = TET_FACES[f].map(|l| v[l]);
+        let nt = n.tet().0;
+        let e = self.m.tets[nt as usize][n.local()];
+        let qold = self.q[t as usize].min(self.q[nt as usize]);
+        let new = [[d, e, a, b], [d, e, b, cc], [d, e, cc, a]];
+        let mut qmin = f64::INFINITY;
+        for &nv in &new {
+            qmin = qmin.min(quality(self.pts(nv)));
+            if !beats(qmin, qold) {
+                return Outcome::NotBetter; // first sign of worse (§9.1)
+            }
+        }
+        if !self.all_positive(&new) {
+            return Outcome::Inverted;
+        }
+        c.old.clear();
+        c.old.extend([t, nt]);
+        c.new.clear();
+        c.new.extend(new);
+        c.qmin = qmin;
+        Outcome::Done
+    }
+
+    /// §9.1 edge removal: the `n` tets around edge `ab` become `2n-4`, two
+    /// per triangle of the best triangulation of the ring. Klincsek's
+    /// dynamic programme (Shewchuk 2002) maximises the worst tet over all
+    /// triangulations in O(n^3); `n = 3` is the 3-2 swap.
+    pub(crate) fn eval_edge_removal(
+        &self,
+        t: u32,
+        a: PointId,
+        b: PointId,
+        s: &mut Scratch,
+        c: &mut Cand,
+    ) -> Outcome {
+        if self.ring(t, a, b, &mut s.tets, &mut s.ring).is_none() {
+            return Outcome::Constrained;
+        }
+        let n = s.ring.len();
+        let qold = s
+            .tets
+            .iter()
+            .map(|&t| self.q[t as usize])
+            .fold(f64::INFINITY, f64::min);
+        const N: usize = MAX_RING;
+        s.tq.clear();
+        s.tq.resize(N * N * N, f64::NAN);
+        s.dp.clear();
+        s.dp.resize(N * N, (f64::INFINITY, 0));
+        let (pa, pb) = (self.m.points[a.idx()], self.m.points[b.idx()]);
+        let r: [P3; N] =
+            std::array::from_fn(|i| s.ring.get(i).map_or([0.0; 3], |p| self.m.points[p.idx()]));
+        for len in 2..n {
+            for i in 0..n - len {
+                let j = i + len;
+                let mut best = (f64::NEG_INFINITY, 0u8);
+                for k in i + 1..j {
+                    let m = s.dp[i * N + k].0.min(s.dp[k * N + j].0);
+                    // Reject at the first sign of worse (§9.1).
+                    if m <= best.0 || !beats(m, qold) {
+                        continue;
+                    }
+                    let slot = &mut s.tq[(i * N + k) * N + j];
+                    if slot.is_nan() {
+                        let q1 = quality([r[i], r[k], r[j], pb]);
+                        *slot = if beats(q1, qold) {
+                            q1.min(quality([r[i], r[j], r[k], pa]))
+                        } else {
+                            q1
+                        };
+                    }
+                    let v = m.min(*slot);
+                    if v > best.0 && beats(v, qold) {
+                        best = (v, k as u8);
+                    }
+                }
+                s.dp[i * N + j] = best;
+            }
+        }
+        let (qnew, _) = s.dp[n - 1];
+        if !beats(qnew, qold) {
+            return Outcome::NotBetter;
+        }
+        c.new.clear();
+        s.stack.clear();
+        s.stack.push((0, (n - 1) as u8));
+        while let Some((i, j)) = s.stack.pop() {
+            let (i, j) = (i as usize, j as usize);
+            if j - i < 2 {
+                continue;
+            }
+            let k = s.dp[i * N + j].1 as usize;
+            let (ri, rk, rj) = (s.ring[i], s.ring[k], s.ring[j]);
+            c.new.push([ri, rk, rj, b]);
+            c.new.push([ri, rj, rk, a]);
+            s.stack.push((i as u8, k as u8));
+            s.stack.push((k as u8, j as u8));
+        }
+        if !self.all_positive(&c.new) {
+            return Outcome::Inverted;
+        }
+        c.old.clear();
+        c.old.extend_from_slice(&s.tets);
+        c.qmin = qnew;
+        Outcome::Done
+    }
+
+    /// The distinct vertices of `tets` other than `p`, into `out`.
+    fn neighbours(&self, p: PointId, tets: &[u32], out: &mut Vec<PointId>) {
+        out.clear();
+        for &t in tets {
+            for v in self.m.tets[t as usize] {
+                if v != p && !out.contains(&v) {
+                    out.push(v);
+                }
+            }
+        }
+    }
+
+    /// §9.2 edge collapse: point `a` merges into `b`; the tets around the
+    /// edge go, the rest of `a`'s ball is re-pointed at `b`. Needs `a` free
+    /// (it disappears) and the link condition Lk(a) ∩ Lk(b) = Lk(ab).
+    pub(crate) fn eval_collapse(
+        &mut self,
+        a: PointId,
+        b: PointId,
+        s: &mut Scratch,
+        c: &mut Cand,
+    ) -> Outcome {
+        if a == b || self.dead_pt[a.idx()] || self.dead_pt[b.idx()] {
+            return Outcome::NotFound;
+        }
+        if self.frozen[a.idx()] {
+            return Outcome::Frozen;
+        }
+        self.ball(a, &mut s.ball);
+        if s.ball.is_empty() {
+            return Outcome::NotFound;
+        }
+        // Ring of ab: the vertices of the tets holding both.
+        s.ring.clear();
+        let mut on_edge = 0;
+        for &t in &s.ball {
+            let v = self.m.tets[t as usize];
+            if v.contains(&b) {
+                on_edge += 1;
+                for x in v {
+                    if x != a && x != b && !s.ring.contains(&x) {
+                        s.ring.push(x);
+                    }
+                }
+            }
+        }
+        if on_edge == 0 {
+            return Outcome::NotFound;
+        }
+        // Link condition, vertices: a common neighbour must be on the ring.
+        self.neighbours(a, &s.ball, &mut s.nb);
+        self.ball(b, &mut s.ball2);
+        self.neighbours(b, &s.ball2, &mut s.nb2);
+        for &x in &s.nb {
+            if x != b && s.nb2.contains(&x) && !s.ring.contains(&x) {
+                return Outcome::LinkCondition;
+            }
+        }
+        // Edges: xy in Lk(a) and Lk(b) must be in Lk(ab), i.e. abxy a tet.
+        let has = |tets: &[u32], x: PointId, y: PointId| {
+            tets.iter().any(|&t| {
+                let v = &self.m.tets[t as usize];
+                v.contains(&x) && v.contains(&y)
+            })
+        };
+        for i in 0..s.ring.len() {
+            for j in i + 1..s.ring.len() {
+                let (x, y) = (s.ring[i], s.ring[j]);
+                let in_ab = s.ball.iter().any(|&t| {
+                    let v = &self.m.tets[t as usize];
+                    v.contains(&b) && v.contains(&x) && v.contains(&y)
+                });
+                if !in_ab && has(&s.ball, x, y) && has(&s.ball2, x, y) {
+                    return Outcome::LinkCondition;
+                }
+            }
+        }
+        let qold = s
+            .ball
+            .iter()
+            .map(|&t| self.q[t as usize])
+            .fold(f64::INFINITY, f64::min);
+        c.new.clear();
+        let mut qmin = f64::INFINITY;
+        for &t in &s.ball {
+            let v = self.m.tets[t as usize];
+            if v.contains(&b) {
+                continue;
+            }
+            let nv = v.map(|x| if x == a { b } else { x });
+            qmin = qmin.min(quality(self.pts(nv)));
+            if !beats(qmin, qold) {
+                return Outcome::NotBetter;
+            }
+            c.new.push(nv);
+        }
+        if !self.all_positive(&c.new) {
+            return Outcome::Inverted;
+        }
+        c.old.clear();
+        c.old.extend_from_slice(&s.ball);
+        c.qmin = qmin;
+        Outcome::Done
+    }
+
+    /// Worst and mean quality of `ball` with `p` at `pos`; `None` when a
+    /// tet would not be positive (exactly and in floating point).
+    pub(crate) fn ball_quality_at(&self, p: PointId, pos: P3, ball: &[u32]) -> Option<(f64, f64)> {
+        let mut qmin = f64::INFINITY;
+        let mut sum = 0.0;
+        for &t in ball {
+            let v = self.m.tets[t as usize];
+            let mut x = self.pts(v);
+            for k in 0..4 {
+                if v[k] == p {
+                    x[k] = pos;
+                }
+            }
+            if !positive(x) {
+                return None;
+            }
+            let q = quality(x);
+            qmin = qmin.min(q);
+            sum += q;
+        }
+        Some((qmin, sum / ball.len() as f64))
+    }
+
+    /// Moves `p` to `pos` and refreshes the qualities of its ball.
+    pub(crate) fn commit_move(&mut self, p: PointId, pos: P3, ball: &[u32]) {
+        self.m.points[p.idx()] = pos;
+        for &t in ball {
+            let v = self.m.tets[t as usize];
+            self.q[t as usize] = quality(self.pts(v));
+            self.tested[t as usize] = false;
+            for x in v {
+                self.settled[x.idx()] = false;
+            }
+        }
+    }
+
+    /// §9.3 Laplacian smoothing of one point with move rejection: `p` goes
+    /// towards the mean of its neighbours (full, half, quarter step); a move
+    /// is kept only when no tet inverts and the ball's worst quality does
+    /// not drop (and its mean rises).
+    pub(crate) fn smooth_point(&mut self, p: PointId, s: &mut Scratch) -> Outcome {
+        if self.dead_pt[p.idx()] {
+            return Outcome::NotFound;
+        }
+        if self.frozen[p.idx()] {
+            return Outcome::Frozen;
+        }
+        let mut ball = std::mem::take(&mut s.ball);
+        self.ball(p, &mut ball);
+        let out = self.smooth_in(p, &ball, s);
+        s.ball = ball;
+        out
+    }
+
+    fn smooth_in(&mut self, p: PointId, ball: &[u32], s: &mut Scratch) -> Outcome {
+        if ball.is_empty() {
+            return Outcome::NotFound;
+        }
+        self.neighbours(p, ball, &mut s.nb);
+        let mut c = [0.0; 3];
+        for &x in &s.nb {
+            let q = self.m.points[x.idx()];
+            for k in 0..3 {
+                c[k] += q[k];
+            }
+        }
+        let lap = c.map(|x| x / s.nb.len() as f64);
+        // The mean of the points that would make each tet of the ball
+        // regular on its face opposite p: follows the local size where
+        // the plain Laplacian mean drifts in graded meshes.
+        let mut ideal = [0.0; 3];
+        for &t in ball {
+            let v = self.m.tets[t as usize];
+            let Some(k) = v.iter().position(|&x| x == p) else {
+                continue;
+            };
+            let [x, y, z] = TET_FACES[k].map(|l| self.m.points[v[l].idx()]);
+            let n = cross(sub(y, x), sub(z, x));
+            let nn = norm(n);
+            let l2 = (dist2(x, y) + dist2(y, z) + dist2(z, x)) / 3.0;
+            let h = (l2 * 2.0 / 3.0).sqrt();
+            for i in 0..3 {
+                // The face's normal points away from p.
+                ideal[i] += (x[i] + y[i] + z[i]) / 3.0 - n[i] / nn.max(f64::MIN_POSITIVE) * h;
+            }
+        }
+        let ideal = ideal.map(|x| x / ball.len() as f64);
+        let p0 = self.m.points[p.idx()];
+        let (qmin, qmean) = ball
+            .iter()
+            .map(|&t| self.q[t as usize])
+            .fold((f64::INFINITY, 0.0), |(m, s), q| (m.min(q), s + q));
+        let qmean = qmean / ball.len() as f64;
+        let mut inverted = false;
+        for (c, w) in [
+            (ideal, 1.0),
+            (ideal, 0.5),
+            (lap, 1.0),
+            (lap, 0.5),
+            (lap, 0.25),
+        ] {
+            let pos = [0, 1, 2].map(|k| p0[k] + w * (c[k] - p0[k]));
+            match self.ball_quality_at(p, pos, ball) {
+                None => inverted = true,
+                Some((m, mean)) => {
+                    if beats(m, qmin) || (m >= qmin && mean > qmean + 1e-9) {
+                        self.commit_move(p, pos, ball);
+                        return Outcome::Done;
+                    }
+                }
+            }
+        }
+        if inverted {
+            Outcome::Inverted
+        } else {
+            Outcome::NotBetter
+        }
+    }
+
+    /// Moves free point `p` to `pos` if no tet inverts and the worst
+    /// quality of its ball does not drop.
+    pub(crate) fn try_move(&mut self, p: PointId, pos: P3, s: &mut Scratch) -> Outcome {
+        if self.dead_pt[p.idx()] {
+            return Outcome::NotFound;
+        }
+        if self.frozen[p.idx()] {
+            return Outcome::Frozen;
+        }
+        let mut ball = std::mem::take(&mut s.ball);
+        self.ball(p, &mut ball);
+        let qmin = ball
+            .iter()
+            .map(|&t| self.q[t as usize])
+            .fold(f64::INFINITY, f64::min);
+        let out = match self.ball_quality_at(p, pos, &ball) {
+            None => Outcome::Inverted,
+            Some((m, _)) if m >= qmin => {
+                self.commit_move(p, pos, &ball);
+                Outcome::Done
+            }
+            Some(_) => Outcome::NotBetter,
+        };
+        s.ball = ball;
+        out
+    }
+
+    /// §9.4 selective movement: try `p` along each of its edges, both ways,
+    /// at a few fractions of the edge length; keep the best move if it
+    /// raises the worst quality of the ball.
+    pub(crate) fn selective_move(&mut self, p: PointId, s: &mut Scratch) -> Outcome {
+        if self.dead_pt[p.idx()] {
+            return Outcome::NotFound;
+        }
+        if self.frozen[p.idx()] {
+            return Outcome::Frozen;
+        }
+        let mut ball = std::mem::take(&mut s.ball);
+        self.ball(p, &mut ball);
+        self.neighbours(p, &ball, &mut s.nb);
+        let qmin = ball
+            .iter()
+            .map(|&t| self.q[t as usize])
+            .fold(f64::INFINITY, f64::min);
+        let p0 = self.m.points[p.idx()];
+        let mut best: Option<(f64, P3)> = None;
+        for &x in &s.nb {
+            let d = parafront_geom::sub(self.m.points[x.idx()], p0);
+            for f in [0.25, 0.1, 0.03, -0.03, -0.1, -0.25] {
+                let pos = [0, 1, 2].map(|k| p0[k] + f * d[k]);
+                if let Some((m, _)) = self.ball_quality_at(p, pos, &ball) {
+                    if beats(m, best.map_or(qmin, |b| b.0)) {
+                        best = Some((m, pos));
+                    }
+                }
+            }
+        }
+        let out = match best {
+            Some((_, pos)) => {
+                self.commit_move(p, pos, &ball);
+                Outcome::Done
+            }
+            None => Outcome::NotBetter,
+        };
+        s.ball = ball;
+        out
+    }
+}

@@ -1,0 +1,48 @@
+//! The one quality measure every operation uses: the mean ratio,
+//! `12 (3|V|)^(2/3) / sum l^2`, signed by the volume. Smooth, scale
+//! invariant, 1 for the regular tet, 0 for a flat one, and cheap (a cube
+//! root, no arc-cosines; §9.4 warns about their cost). It equals
+//! `parafront_mesh::quality::mean_ratio`.
+use parafront_geom::{dist2, tet_volume6, P3};
+
+#[inline]
+pub fn quality(p: [P3; 4]) -> f64 {
+    let v6 = tet_volume6(p[0], p[1], p[2], p[3]);
+    let l2 = dist2(p[0], p[1])
+        + dist2(p[0], p[2])
+        + dist2(p[0], p[3])
+        + dist2(p[1], p[2])
+        + dist2(p[1], p[3])
+        + dist2(p[2], p[3]);
+    if l2 > 0.0 {
+        let v3 = 0.5 * v6; // 3V
+        (12.0 * (v3 * v3).cbrt() / l2).copysign(v6)
+    } else {
+        0.0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn matches_the_mesh_crate() {
+        let p = [
+            [0.0, 0.0, 0.0],
+            [1.0, 0.1, 0.0],
+            [0.2, 0.9, 0.1],
+            [0.3, 0.2, 0.7],
+        ];
+        let a = quality(p);
+        let b = parafront_mesh::quality::mean_ratio(p);
+        assert!((a - b).abs() < 1e-12, "{a} {b}");
+        let r = [
+            [1.0, 1.0, 1.0],
+            [1.0, -1.0, -1.0],
+            [-1.0, 1.0, -1.0],
+            [-1.0, -1.0, 1.0],
+        ];
+        assert!((quality(r).abs() - 1.0).abs() < 1e-12);
+    }
+}

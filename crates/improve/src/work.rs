@@ -1,0 +1,435 @@
+//! The mutable working state of an improvement run: the mesh, a tet per
+//! point, the quality per tet, dead slots, and the two walks every
+//! operation needs (the ball of a point, the ring of an edge). Local
+//! operations replace a cavity of tets by new tets through [`Work::replace`],
+//! which keeps `neigh` consistent without a global rebuild.
+use crate::quality::quality;
+use parafront_geom::P3;
+use parafront_mesh::{FaceRef, PointId, TetMesh, NO_FACE, TET_FACES};
+
+/// Vertex ids of a dead tet slot.
+pub(crate) const DEAD: [PointId; 4] = [PointId(u32::MAX); 4];
+/// Most tets around an edge that edge removal considers.
+pub(crate) const MAX_RING: usize = 10;
+
+pub(crate) struct Work<'m> {
+    pub m: &'m mut TetMesh,
+    /// Points that never move or disappear: the caller's frozen points plus
+    /// every point of a boundary or region-interface face.
+    pub frozen: Vec<bool>,
+    pub dead_pt: Vec<bool>,
+    /// A tet containing each point (`u32::MAX` when none).
+    pub p2t: Vec<u32>,
+    /// Quality of each tet ([`quality`]); `INFINITY` for dead slots.
+    pub q: Vec<f64>,
+    /// Tested and left alone by the swapper since it last changed (§9.1).
+    pub tested: Vec<bool>,
+    /// Smoothing left the point where it was and nothing in its ball has
+    /// changed since: smoothing it again would decide the same (§9.1's
+    /// marking, applied to §9.3).
+    pub settled: Vec<bool>,
+    free: Vec<u32>,
+    stamp: Vec<u32>,
+    gen: u32,
+    outer: Vec<([u32; 3], FaceRef)>,
+    link: Vec<u32>,
+    slots: Vec<u32>,
+    used: Vec<bool>,
+    cav: Vec<PointId>,
+}
+
+#[inline]
+pub(crate) fn key3(mut k: [u32; 3]) -> [u32; 3] {
+    k.sort_unstable();
+    k
+}
+
+/// Whether the permutation `p` of 0..4 is even.
+#[inline]
+pub(crate) fn even(p: [usize; 4]) -> bool {
+    let mut inv = 0;
+    for i in 0..4 {
+        for j in i + 1..4 {
+            inv += usize::from(p[i] > p[j]);
+        }
+    }
+    inv % 2 == 0
+}
+
+impl<'m> Work<'m> {
+    /// Needs `m.neigh` built. `frozen` is per point (shorter means the rest
+    /// is free).
+    pub fn new(m: &'m mut TetMesh, frozen: &[bool]) -> Work<'m> {
+        let np = m.points.len();
+        let nt = m.tets.len();
+        if m.region.len() < nt {
+            m.region.resize(nt, 0);
+        }
+        let mut fr = vec![false; np];
+        fr[..frozen.len().min(np)].copy_from_slice(&frozen[..frozen.len().min(np)]);
+        let mut p2t = vec![u32::MAX; np];
+        let mut q = Vec::with_capacity(nt);
+        for (t, v) in m.tets.iter().enumerate() {
+            for f in 0..4 {
+                p2t[v[f].idx()] = t as u32;
+                let n = m.neigh[4 * t + f];
+                let constrained = n.is_none() || m.region[n.tet().idx()] != m.region[t];
+                if constrained {
+                    for l in TET_FACES[f] {
+                        fr[v[l].idx()] = true;
+                    }
+                }
+            }
+            q.push(quality(v.map(|p| m.points[p.idx()])));
+        }
+        Work {
+            frozen: fr,
+            dead_pt: vec![false; np],
+            p2t,
+            tested: vec![false; nt],
+            settled: vec![false; np],
+            q,
+            free: Vec::new(),
+            stamp: vec![0; nt],
+            gen: 0,
+            outer: Vec::new(),
+            link: Vec::new(),
+            slots: Vec::new(),
+            used: Vec::new(),
+            cav: Vec::new(),
+            m,
+        }
+    }
+
+    #[inline]
+    pub fn pts(&self, v: [PointId; 4]) -> [P3; 4] {
+        v.map(|p| self.m.points[p.idx()])
+    }
+
+    #[inline]
+    pub fn alive(&self, t: u32) -> bool {
+        self.m.tets[t as usize][0] != DEAD[0]
+    }
+
+    /// The face across face `f` of `t` when it is free to change: it has a
+    /// tet behind it in the same region (§9.1: constrained faces stay).
+    #[inline]
+    pub fn free_neighbour(&self, t: u32, f: usize) -> Option<FaceRef> {
+        let n = self.m.neigh[4 * t as usize + f];
+        (!n.is_none() && self.m.region[n.tet().idx()] == self.m.region[t as usize]).then_some(n)
+    }
+
+    /// The tets containing `p`, by a walk over faces through `p` (a point
+    /// of a manifold mesh has a connected ball). Empty when `p` is dead.
+    pub fn ball(&mut self, p: PointId, out: &mut Vec<u32>) {
+        out.clear();
+        let t0 = self.p2t[p.idx()];
+        // An empty ball makes every operation on p a no-op, never a walk
+        // from a tet that does not hold p.
+        if t0 == u32::MAX || !self.m.tets[t0 as usize].contains(&p) {
+            debug_assert!(t0 == u32::MAX, "p2t of {p} is stale");
+            return;
+        }
+        self.gen = self.gen.wrapping_add(1);
+        if self.gen == 0 {
+            self.stamp.iter_mut().for_each(|s| *s = 0);
+            self.gen = 1;
+        }
+        if self.stamp.len() < self.m.tets.len() {
+            self.stamp.resize(self.m.tets.len(), 0);
+        }
+        self.stamp[t0 as usize] = self.gen;
+        out.push(t0);
+        let mut i = 0;
+        while i < out.len() {
+            let t = out[i] as usize;
+            i += 1;
+            for f in 0..4 {
+                if self.m.tets[t][f] == p {
+                    continue;
+                }
+                let n = self.m.neigh[4 * t + f];
+                if n.is_none() {
+                    continue;
+                }
+                let nt = n.tet().idx();
+                if self.stamp[nt] != self.gen {
+                    self.stamp[nt] = self.gen;
+                    out.push(nt as u32);
+                }
+            }
+        }
+    }
+
+    /// The tets around edge `ab` of tet `t`, in order, and the ring of
+    /// vertices: tet `i` is `(a, b, ring[i], ring[i+1])`, positive. `None`
+    /// when the edge is on a constrained face or the ring is longer than
+    /// [`MAX_RING`].
+    pub fn ring(
+        &self,
+        t: u32,
+        a: PointId,
+        b: PointId,
+        tets: &mut Vec<u32>,
+        ring: &mut Vec<PointId>,
+    ) -> Option<()> {
+        tets.clear();
+        ring.clear();
+        let v = self.m.tets[t as usize];
+        let ia = v.iter().position(|&x| x == a)?;
+        let ib = v.iter().position(|&x| x == b)?;
+        let mut o = (0..4).filter(|&k| k != ia && k != ib);
+        let (k, l) = (o.next()?, o.next()?);
+        let (mut r0, mut r1) = if even([ia, ib, k, l]) {
+            (v[k], v[l])
+        } else {
+            (v[l], v[k])
+        };
+        let mut cur = t;
+        loop {
+            tets.push(cur);
+            ring.push(r0);
+            if tets.len() > MAX_RING {
+                return None;
+            }
+            let cv = self.m.tets[cur as usize];
+            let lf = cv.iter().position(|&x| x == r0)?;
+            let n = self.free_neighbour(cur, lf)?;
+            let nt = n.tet().0;
+            if nt == t {
+                return Some(());
+            }
+            let nv = self.m.tets[nt as usize];
+            let r2 = *nv.iter().find(|&&x| x != a && x != b && x != r1)?;
+            cur = nt;
+            r0 = r1;
+            r1 = r2;
+        }
+    }
+
+    /// Replaces the tets `old` (all of one region) by `new`, which must
+    /// cover the same cavity: the faces of `new` pair up among themselves or
+    /// with the cavity's outer faces, each exactly once. Returns false, and
+    /// changes nothing, when they do not.
+    pub fn replace(&mut self, old: &[u32], new: &[[PointId; 4]]) -> bool {
+        let region = self.m.region[old[0] as usize];
+        let mut outer = std::mem::take(&mut self.outer);
+        let mut link = std::mem::take(&mut self.link);
+        outer.clear();
+        for &t in old {
+            let v = self.m.tets[t as usize];
+            for (f, fl) in TET_FACES.iter().enumerate() {
+                let n = self.m.neigh[4 * t as usize + f];
+                if !n.is_none() && old.contains(&n.tet().0) {
+                    continue;
+                }
+                outer.push((key3(fl.map(|l| v[l].0)), n));
+            }
+        }
+        // Dry run: link[4i+g] = outer index, or 1<<31 | (4j+h) for a face of
+        // another new tet.
+        const NEWF: u32 = 1 << 31;
+        const UNSET: u32 = u32::MAX;
+        link.clear();
+        link.resize(4 * new.len(), UNSET);
+        let mut used = std::mem::take(&mut self.used);
+        used.clear();
+        used.resize(outer.len(), false);
+        let mut ok = true;
+        'faces: for i in 0..new.len() {
+            for (g, fl) in TET_FACES.iter().enumerate() {
+                if !ok {
+                    break 'faces;
+                }
+                if link[4 * i + g] != UNSET {
+                    continue;
+                }
+                let k = key3(fl.map(|l| new[i][l].0));
+                if let Some(o) = outer.iter().position(|x| x.0 == k) {
+                    if used[o] {
+                        ok = false;
+                        continue;
+                    }
+                    used[o] = true;
+                    link[4 * i + g] = o as u32;
+                    continue;
+                }
+                let mut found = false;
+                for j in i + 1..new.len() {
+                    for (h, hl) in TET_FACES.iter().enumerate() {
+                        if key3(hl.map(|l| new[j][l].0)) == k {
+                            if found || link[4 * j + h] != UNSET {
+                                ok = false;
+                            }
+                            found = true;
+                            link[4 * i + g] = NEWF | (4 * j + h) as u32;
+                            link[4 * j + h] = NEWF | (4 * i + g) as u32;
+                        }
+                    }
+                }
+                ok &= found;
+            }
+        }
+        ok &= used.iter().all(|&u| u);
+        self.used = used;
+        if !ok {
+            self.outer = outer;
+            self.link = link;
+            return false;
+        }
+        // Slots: the old ones first, then free ones, then new ones.
+        let mut slots = std::mem::take(&mut self.slots);
+        slots.clear();
+        for i in 0..new.len() {
+            let s = if i < old.len() {
+                old[i]
+            } else if let Some(s) = self.free.pop() {
+                s
+            } else {
+                self.m.tets.push(DEAD);
+                self.m.region.push(region);
+                self.m.neigh.extend([NO_FACE; 4]);
+                self.q.push(f64::INFINITY);
+                self.tested.push(false);
+                (self.m.tets.len() - 1) as u32
+            };
+            slots.push(s);
+        }
+        // Points of the cavity that may lose their p2t tet.
+        let mut cav = std::mem::take(&mut self.cav);
+        cav.clear();
+        for &t in old {
+            for p in self.m.tets[t as usize] {
+                if !cav.contains(&p) {
+                    cav.push(p);
+                }
+            }
+        }
+        for &t in &old[new.len().min(old.len())..] {
+            self.m.tets[t as usize] = DEAD;
+            self.q[t as usize] = f64::INFINITY;
+            for f in 0..4 {
+                self.m.neigh[4 * t as usize + f] = NO_FACE;
+            }
+            self.free.push(t);
+        }
+        for (i, &s) in slots.iter().enumerate() {
+            let s = s as usize;
+            self.m.tets[s] = new[i];
+            self.m.region[s] = region;
+            self.q[s] = quality(self.pts(new[i]));
+            self.tested[s] = false;
+            for g in 0..4 {
+                let me = FaceRef::of(parafront_mesh::TetId(s as u32), g);
+                let l = link[4 * i + g];
+                if l & NEWF != 0 {
+                    let jh = (l & !NEWF) as usize;
+                    self.m.neigh[4 * s + g] =
+                        FaceRef::of(parafront_mesh::TetId(slots[jh / 4]), jh % 4);
+                } else {
+                    let n = outer[l as usize].1;
+                    self.m.neigh[4 * s + g] = n;
+                    if !n.is_none() {
+                        self.m.neigh[n.0 as usize] = me;
+                        // Its surroundings changed: worth testing again.
+                        self.tested[n.tet().idx()] = false;
+                    }
+                }
+            }
+            for p in new[i] {
+                self.p2t[p.idx()] = s as u32;
+                self.settled[p.idx()] = false;
+            }
+        }
+        // Cavity points in no new tet: point them at an outer tet.
+        for &p in &cav {
+            let t = self.p2t[p.idx()];
+            if t != u32::MAX && self.m.tets[t as usize].contains(&p) {
+                continue;
+            }
+            self.p2t[p.idx()] = outer
+                .iter()
+                .find(|o| !o.1.is_none() && o.0.contains(&p.0))
+                .map_or(u32::MAX, |o| o.1.tet().0);
+        }
+        self.outer = outer;
+        self.link = link;
+        self.slots = slots;
+        self.cav = cav;
+        true
+    }
+
+    /// Drops dead tets, and dead points when `drop_points`, renumbering
+    /// what is left in order (surviving ids keep their relative order).
+    /// Returns which points died.
+    pub fn compact(self, drop_points: bool) -> Vec<bool> {
+        let m = self.m;
+        if !drop_points {
+            let keep = vec![false; m.points.len()];
+            compact_arrays(m, &keep);
+            return self.dead_pt;
+        }
+        compact_arrays(m, &self.dead_pt);
+        self.dead_pt
+    }
+}
+
+/// Drops the dead tet slots and the points marked in `dead_pt`,
+/// renumbering tets, neighbours (when built) and boundary triangles.
+pub(crate) fn compact_arrays(m: &mut TetMesh, dead_pt: &[bool]) {
+    let nt = m.tets.len();
+    let has_neigh = m.neigh.len() == 4 * nt;
+    let mut tmap = vec![u32::MAX; nt];
+    let mut k = 0u32;
+    for t in 0..nt {
+        if m.tets[t] != DEAD {
+            tmap[t] = k;
+            k += 1;
+        }
+    }
+    let mut pmap = vec![u32::MAX; m.points.len()];
+    let mut kp = 0u32;
+    for p in 0..m.points.len() {
+        if !dead_pt.get(p).copied().unwrap_or(false) {
+            pmap[p] = kp;
+            kp += 1;
+        }
+    }
+    let mut w = 0;
+    for t in 0..nt {
+        if tmap[t] == u32::MAX {
+            continue;
+        }
+        m.tets[w] = m.tets[t].map(|p| PointId(pmap[p.idx()]));
+        m.region[w] = m.region[t];
+        if has_neigh {
+            for f in 0..4 {
+                let n = m.neigh[4 * t + f];
+                m.neigh[4 * w + f] = if n.is_none() {
+                    NO_FACE
+                } else {
+                    FaceRef(tmap[n.tet().idx()] * 4 + n.local() as u32)
+                };
+            }
+        }
+        w += 1;
+    }
+    m.tets.truncate(w);
+    m.region.truncate(w);
+    if has_neigh {
+        m.neigh.truncate(4 * w);
+    } else {
+        m.neigh.clear();
+    }
+    let mut wp = 0;
+    for p in 0..m.points.len() {
+        if pmap[p] != u32::MAX {
+            m.points[wp] = m.points[p];
+            wp += 1;
+        }
+    }
+    m.points.truncate(wp);
+    for t in &mut m.bnd_tris {
+        *t = t.map(|p| PointId(pmap[p.idx()]));
+    }
+}
