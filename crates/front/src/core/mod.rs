@@ -740,8 +740,8 @@ impl<'a> Front<'a> {
             .min(MAX_GROWTH_PER_TET * emax);
         let dm = (dist(m, pa) + dist(m, pb) + dist(m, pc)) / 3.0;
         // AF2.1: the ideal point sits at a regular tet's height.
-        let alpha = (h * h - dm * dm).max(0.25 * dm * dm).sqrt();
-        let pstar = add(m, scale(nrm, alpha));
+        let mut alpha = (h * h - dm * dm).max(0.25 * dm * dm).sqrt();
+        let mut pstar = add(m, scale(nrm, alpha));
         let star_ok = self.region.point_ok(pstar);
         if !star_ok {
             return Outcome::Prohibited;
@@ -763,6 +763,14 @@ impl<'a> Front<'a> {
         near_f.clear();
         cands.clear();
         self.gather(&qbox, fid, &mut near_f, &mut near_p);
+        // A gap narrower than two ideal heights (a thin wall, or two fronts
+        // meeting): the point goes to the middle, where the other side's
+        // point will find it, rather than leave a slab only slivers fill.
+        let gap = self.ray_gap(m, nrm, &near_f, 2.0 * alpha);
+        if gap < 2.0 * alpha && gap > 0.8 * alpha {
+            alpha = 0.5 * gap;
+            pstar = add(m, scale(nrm, alpha));
+        }
         // The grid's layout follows from the order of operations alone, so
         // the query order is deterministic without sorting.
         let mut star_clear = true;
@@ -857,6 +865,45 @@ impl<'a> Front<'a> {
             }
             None => Outcome::Failed,
         }
+    }
+
+    /// Distance along the ray `m + t n` to the first front face it meets,
+    /// or `limit` if none closer.
+    fn ray_gap(&self, m: P3, n: P3, near_f: &[Near], limit: f64) -> f64 {
+        let mut best = limit;
+        let end = add(m, scale(n, limit));
+        let mut rb = Aabb { min: m, max: m };
+        rb.grow(end);
+        for nf in near_f {
+            if !nf.bb.overlaps(&rb) {
+                continue;
+            }
+            let g = nf.v.map(|i| self.pts[i as usize]);
+            // Moller-Trumbore; faces through m (t ~ 0) are the neighbours.
+            let e1 = sub(g[1], g[0]);
+            let e2 = sub(g[2], g[0]);
+            let pv = cross(n, e2);
+            let det = dot(e1, pv);
+            if det.abs() < 1e-300 {
+                continue;
+            }
+            let inv = 1.0 / det;
+            let tv = sub(m, g[0]);
+            let u = dot(tv, pv) * inv;
+            if !(0.0..=1.0).contains(&u) {
+                continue;
+            }
+            let qv = cross(tv, e1);
+            let w = dot(n, qv) * inv;
+            if w < 0.0 || u + w > 1.0 {
+                continue;
+            }
+            let t = dot(e2, qv) * inv;
+            if t > 1e-6 * limit && t < best {
+                best = t;
+            }
+        }
+        best
     }
 
     /// AF2.3: tet `v + q` must cross no front face and hold no front point.
