@@ -1,0 +1,143 @@
+//! The domain-defining grid (paper §5, step 1) and what the parallel
+//! passes ask of it: which DDG tets hold a point ([`Locator`]), how many
+//! fine tets each DDG tet will hold, the balanced split into parts
+//! (§6, step 2), the shifted partitions of passes 2 and 3 and the region
+//! filter of one part (§7).
+
+mod locate;
+mod partition;
+
+pub use locate::{Interfaces, Locator, PartFilter};
+pub use partition::{imbalance, rcb, shifted, tet_weights, Shift};
+
+use parafront_front::{advance, Everywhere, FrontError, FrontInput, FrontOptions, SizeMode};
+use parafront_geom::P3;
+use std::time::Instant;
+
+/// Default growth factor `c_i` (§5: typical values 1.5 to 1.7).
+pub const DEFAULT_GROWTH: f64 = 1.6;
+
+/// The coarse mesh: fine at the surface (it keeps the surface triangles),
+/// coarse inside.
+#[derive(Clone, Debug, Default)]
+pub struct Ddg {
+    /// Input points first (same ids as the front handed in), then new ones.
+    pub points: Vec<P3>,
+    pub tets: Vec<[u32; 4]>,
+    /// `neigh[4t+f]` = `4t'+f'` or `u32::MAX` (from the front).
+    pub neigh: Vec<u32>,
+    /// Points of the input front.
+    pub n_input: usize,
+    /// The growth factor the build used (see [`build`]).
+    pub growth: f64,
+    pub seconds: f64,
+}
+
+/// Builds the DDG of one closed front: the scalar front with its size
+/// overridden by the growth factor `c` (§5). The front does not always
+/// close at a large `c` (it gets stuck where coarse tets meet the surface
+/// layer); the build then retries with a smaller factor, down to 1.1, and
+/// records the factor it used in `Ddg::growth`.
+pub fn build(
+    points: Vec<P3>,
+    point_size: Vec<f64>,
+    faces: Vec<[u32; 3]>,
+    c: f64,
+) -> Result<Ddg, FrontError> {
+    let t0 = Instant::now();
+    let n_input = points.len();
+    let mut tries: Vec<f64> = vec![c];
+    tries.extend([1.5, 1.4, 1.3, 1.2, 1.1].into_iter().filter(|&x| x < c));
+    let mut last = None;
+    for &g in &tries {
+        let r = advance(
+            FrontInput {
+                points: points.clone(),
+                point_size: point_size.clone(),
+                faces: faces.clone(),
+            },
+            SizeMode::Growth(g),
+            &Everywhere,
+            &FrontOptions {
+                recovery_rounds: 12,
+                ..FrontOptions::default()
+            },
+        );
+        match r {
+            Ok(r) => {
+                return Ok(Ddg {
+                    points: r.points,
+                    tets: r.tets,
+                    neigh: r.neigh,
+                    n_input,
+                    growth: g,
+                    seconds: t0.elapsed().as_secs_f64(),
+                })
+            }
+            Err(e) => last = Some(e),
+        }
+    }
+    Err(last.expect("at least one try"))
+}
+
+impl Ddg {
+    pub fn tet_points(&self, t: usize) -> [P3; 4] {
+        self.tets[t].map(|p| self.points[p as usize])
+    }
+    pub fn centroid(&self, t: usize) -> P3 {
+        let p = self.tet_points(t);
+        let mut c = [0.0; 3];
+        for q in p {
+            for k in 0..3 {
+                c[k] += 0.25 * q[k];
+            }
+        }
+        c
+    }
+    /// Tets around each point, CSR (`start`, `list`), ascending tet order.
+    pub fn point_tets(&self) -> (Vec<u32>, Vec<u32>) {
+        let mut start = vec![0u32; self.points.len() + 1];
+        for t in &self.tets {
+            for &p in t {
+                start[p as usize + 1] += 1;
+            }
+        }
+        for i in 0..self.points.len() {
+            start[i + 1] += start[i];
+        }
+        let mut fill = start.clone();
+        let mut list = vec![0u32; start[self.points.len()] as usize];
+        for (t, tv) in self.tets.iter().enumerate() {
+            for &p in tv {
+                list[fill[p as usize] as usize] = t as u32;
+                fill[p as usize] += 1;
+            }
+        }
+        (start, list)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use parafront_surface::generate;
+
+    #[test]
+    fn the_ddg_of_a_sphere_is_coarse_inside_and_keeps_the_surface() {
+        let s = generate::icosphere([0.0; 3], 1.0, 3);
+        let faces: Vec<[u32; 3]> = s.tris.iter().map(|t| [t[0], t[2], t[1]]).collect();
+        let h = s.mean_edge_lengths();
+        let d = build(s.points.clone(), h, faces, DEFAULT_GROWTH).unwrap();
+        let n_new = d.points.len() - d.n_input;
+        // §5: about as many extra points as surface points, or fewer.
+        assert!(n_new > 0 && n_new <= 2 * d.n_input, "{n_new} new points for {} surface points", d.n_input);
+        let vol: f64 = (0..d.tets.len())
+            .map(|t| {
+                let p = d.tet_points(t);
+                parafront_geom::tet_volume6(p[0], p[1], p[2], p[3]) / 6.0
+            })
+            .sum();
+        let want = s.signed_volume().abs();
+        assert!((vol - want).abs() < 1e-9 * want.abs().max(1.0), "{vol} vs {want}");
+    }
+}
