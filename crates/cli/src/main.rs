@@ -1,5 +1,6 @@
 //! `parafront`: the command line. A thin layer: each subcommand parses its
 //! flags into the library's option structs and calls one function.
+mod parallel;
 mod plot;
 
 use clap::{Args, Parser, Subcommand};
@@ -91,6 +92,16 @@ struct MeshArgs {
     /// Worker threads (default: all cores).
     #[arg(long)]
     threads: Option<usize>,
+    /// Parts of the parallel mesher (the paper's nproc; 1: serial front).
+    #[arg(long, default_value_t = 1)]
+    parts: usize,
+    /// Growth factor of the domain-defining grid (§5).
+    #[arg(long)]
+    ddg_growth: Option<f64>,
+    /// With --parts > 1, also write the partitioned mesh: this .pvtu and
+    /// one .vtu per part beside it.
+    #[arg(long)]
+    pvtu: Option<PathBuf>,
     /// Also plot the quality histograms to this file (.svg or .png).
     #[arg(long)]
     plot: Option<PathBuf>,
@@ -199,6 +210,11 @@ fn mesh_options(a: &MeshArgs) -> Result<MeshOptions, Fail> {
         o.size.gradation = v;
     }
     o.threads = a.threads.unwrap_or(0);
+    if a.parts == 0 {
+        return Err(Fail(2, "--parts must be at least 1".into()));
+    }
+    o.parts = a.parts;
+    o.ddg_growth = a.ddg_growth.unwrap_or(0.0);
     Ok(o)
 }
 
@@ -239,7 +255,12 @@ fn run_mesh(s: &Surface, name: &str, out: &Path, a: &MeshArgs, w: &WriteArgs) ->
     sum.stages.push(("write", t0.elapsed().as_secs_f64()));
     let q = parafront_pipeline::quality_report(&mesh, s, &opts);
     print_summary(&sum, &q);
+    parallel::print_parallel(&sum);
     println!("wrote {}", out.display());
+    if let Some(p) = &a.pvtu {
+        parallel::write_partitioned(p, &mesh, &sum, &wopts)?;
+        println!("wrote {} ({} pieces)", p.display(), sum.pieces.len());
+    }
     if let Some(p) = &a.plot {
         plot::plot_histograms(&q, None, p)?;
         println!("wrote {}", p.display());

@@ -12,6 +12,7 @@ pub use partition::{imbalance, rcb, shifted, tet_weights, Shift};
 
 use parafront_front::{advance, Everywhere, FrontError, FrontInput, FrontOptions, SizeMode};
 use parafront_geom::P3;
+use parafront_size::{SizeField, SizeOptions, Sizing};
 use std::time::Instant;
 
 /// Default growth factor `c_i` (§5: typical values 1.5 to 1.7).
@@ -28,56 +29,93 @@ pub struct Ddg {
     pub neigh: Vec<u32>,
     /// Points of the input front.
     pub n_input: usize,
-    /// The growth factor the build used (see [`build`]).
+    /// The growth factor.
     pub growth: f64,
+    pub mode: DdgMode,
     pub seconds: f64,
 }
 
-/// Builds the DDG of one closed front: the scalar front with its size
-/// overridden by the growth factor `c` (§5). The front does not always
-/// close at a large `c` (it gets stuck where coarse tets meet the surface
-/// layer); the build then retries with a smaller factor, down to 1.1, and
-/// records the factor it used in `Ddg::growth`.
+#[derive(Debug, thiserror::Error)]
+pub enum DdgError {
+    #[error("{0}")]
+    Front(#[from] FrontError),
+    #[error("its size field: {0}")]
+    Size(#[from] parafront_size::SizeError),
+}
+
+/// How the DDG's sizes were set.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum DdgMode {
+    /// §5 as written: sizes multiplied by `c` per face removed.
+    #[default]
+    Growth,
+    /// The same growth as a field: the surface size grown linearly by
+    /// `c - 1` per unit distance (what `c` per layer amounts to), used when
+    /// the front does not close under the per-face rule.
+    Graded,
+}
+
+/// Builds the DDG of one closed front (§5): the scalar front with its size
+/// overridden by the growth factor `c`. Under the per-face rule the front
+/// can get stuck where coarse tets meet the surface layer (its recovery
+/// then takes long), so a first try gets few recovery rounds; if it fails
+/// the build uses the equivalent graded field, which the front closes as
+/// reliably as a fine mesh.
 pub fn build(
     points: Vec<P3>,
     point_size: Vec<f64>,
     faces: Vec<[u32; 3]>,
     c: f64,
-) -> Result<Ddg, FrontError> {
+) -> Result<Ddg, DdgError> {
     let t0 = Instant::now();
     let n_input = points.len();
-    let mut tries: Vec<f64> = vec![c];
-    tries.extend([1.5, 1.4, 1.3, 1.2, 1.1].into_iter().filter(|&x| x < c));
-    let mut last = None;
-    for &g in &tries {
-        let r = advance(
-            FrontInput {
-                points: points.clone(),
-                point_size: point_size.clone(),
-                faces: faces.clone(),
-            },
-            SizeMode::Growth(g),
-            &Everywhere,
-            &FrontOptions {
-                recovery_rounds: 12,
-                ..FrontOptions::default()
-            },
-        );
-        match r {
-            Ok(r) => {
-                return Ok(Ddg {
-                    points: r.points,
-                    tets: r.tets,
-                    neigh: r.neigh,
-                    n_input,
-                    growth: g,
-                    seconds: t0.elapsed().as_secs_f64(),
-                })
-            }
-            Err(e) => last = Some(e),
-        }
+    let done = |r: parafront_front::FrontResult, mode| Ddg {
+        points: r.points,
+        tets: r.tets,
+        neigh: r.neigh,
+        n_input,
+        growth: c,
+        mode,
+        seconds: t0.elapsed().as_secs_f64(),
+    };
+    let r = advance(
+        FrontInput {
+            points: points.clone(),
+            point_size: point_size.clone(),
+            faces: faces.clone(),
+        },
+        SizeMode::Growth(c),
+        &Everywhere,
+        &FrontOptions {
+            recovery_rounds: 0,
+            ..FrontOptions::default()
+        },
+    );
+    if let Ok(r) = r {
+        return Ok(done(r, DdgMode::Growth));
     }
-    Err(last.expect("at least one try"))
+    let surf = parafront_surface::Surface::one_patch(points.clone(), faces.clone());
+    let sizing = Sizing::build(
+        &surf,
+        &SizeOptions {
+            gradation: c,
+            ..SizeOptions::default()
+        },
+        None,
+    )
+?;
+    let field = |p: P3| sizing.size(p);
+    let r = advance(
+        FrontInput {
+            point_size,
+            points,
+            faces,
+        },
+        SizeMode::Field(&field),
+        &Everywhere,
+        &FrontOptions::default(),
+    )?;
+    Ok(done(r, DdgMode::Graded))
 }
 
 impl Ddg {

@@ -44,7 +44,7 @@ impl Default for ParOptions {
 #[derive(Debug, thiserror::Error)]
 pub enum PassError {
     #[error("domain-defining grid: {0}")]
-    Ddg(FrontError),
+    Ddg(#[from] ddg::DdgError),
     #[error("pass {pass}, part {part}: {source}")]
     Pass {
         pass: u8,
@@ -63,6 +63,8 @@ pub struct ParStats {
     pub ddg_points: usize,
     pub ddg_surface_points: usize,
     pub ddg_growth: f64,
+    /// The DDG used the graded field (the per-face growth got stuck).
+    pub ddg_graded: bool,
     pub ddg_seconds: f64,
     pub partition_seconds: f64,
     /// Max over mean of the predicted (DDG weight) load.
@@ -190,6 +192,7 @@ pub fn mesh_parallel<C: Comm>(
     st.ddg_points = d.points.len();
     st.ddg_surface_points = d.n_input;
     st.ddg_growth = d.growth;
+    st.ddg_graded = d.mode == ddg::DdgMode::Graded;
     st.ddg_seconds = d.seconds;
 
     // §6 step 2: weights and the balanced split.
@@ -418,7 +421,7 @@ fn front_call(
     .map_err(|e| (k as usize, e))?;
     let mut res = res;
     let n_in = gids.len();
-    close_pockets(&mut res, |i| i as usize >= n_in || input_ok[i as usize], &filter, size);
+    close_pockets(&mut res, |i| i as usize >= n_in || input_ok[i as usize], size);
     Ok(Made {
         res: Some(res),
         input_gid: gids,
@@ -427,17 +430,22 @@ fn front_call(
     })
 }
 
+/// Largest pocket (faces) a pass closes itself.
+const MAX_POCKET: usize = 4000;
+/// Recovery rounds a pocket gets (the serial front's default is 60).
+const POCKET_ROUNDS: u32 = 8;
+
 /// Recovery inside a pass (§7 needs it as much as the serial front does):
 /// the faces a pass could not advance without relaxing its acceptance are
 /// left behind, and many form small closed pockets inside the part's own
 /// region. Each such pocket (an edge-connected set of faces the part owns,
-/// closed on its own) is closed here by the front with recovery on, under
-/// the part's filter; a pocket that reaches out of the region (faces held)
-/// or stays stuck is left as it was for the next pass. Returns the tets made.
+/// closed on its own, facing in, small) is closed here by the front with
+/// recovery on: a closed front bounds what it fills, so no filter is
+/// needed. A pocket that stays stuck is left as it was for the next pass.
+/// Returns the tets made.
 fn close_pockets(
     res: &mut parafront_front::FrontResult,
     ok: impl Fn(u32) -> bool,
-    filter: &dyn parafront_front::RegionFilter,
     size: &(dyn Fn(P3) -> f64 + Sync),
 ) -> usize {
     let own: Vec<usize> = (0..res.front.len())
@@ -495,7 +503,24 @@ fn close_pockets(
             let n = |x: (u32, u32)| e.partition_point(|y| *y <= x) - e.partition_point(|y| *y < x);
             n((a, b)) == n((b, a))
         });
-        if closed {
+        // A large closed set is not a pocket (it may wrap another part's
+        // region); it waits for the next pass.
+        // A pocket is a small cavity: the faces point into it (negative
+        // signed volume), and it holds about a tet per face. A closed set
+        // facing out bounds the rest of the region, not a pocket.
+        let mut vol = 0.0;
+        let mut hsum = 0.0;
+        for f in &faces {
+            let [a, b, c] = f.map(|i| res.points[i as usize]);
+            vol += parafront_geom::dot(a, parafront_geom::cross(b, c)) / 6.0;
+            hsum += f.iter().map(|&i| res.point_size[i as usize]).sum::<f64>() / 3.0;
+        }
+        let hm = hsum / faces.len() as f64;
+        let pocket = vol < 0.0 && -vol <= faces.len() as f64 * hm * hm * hm;
+        if std::env::var_os("PARAFRONT_DEBUG_PASS4").is_some() && closed {
+            eprintln!("pocket: {} faces, vol {vol:.3e}, h {hm:.3e}, taken {}", faces.len(), pocket && faces.len() <= MAX_POCKET);
+        }
+        if closed && pocket && faces.len() <= MAX_POCKET {
             let mut pts: Vec<u32> = faces.iter().flatten().copied().collect();
             pts.sort_unstable();
             pts.dedup();
@@ -507,8 +532,12 @@ fn close_pockets(
                     faces: faces.iter().map(|f| f.map(local)).collect(),
                 },
                 SizeMode::Field(size),
-                filter,
-                &FrontOptions::default(),
+                &Everywhere,
+                &FrontOptions {
+                    recovery_rounds: POCKET_ROUNDS,
+                    max_points: 50 * faces.len() + pts.len(),
+                    ..FrontOptions::default()
+                },
             );
             if let Ok(r) = r {
                 if r.front.is_empty() {

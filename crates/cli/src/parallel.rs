@@ -1,0 +1,128 @@
+//! The parallel mesher's report, its partitioned output and `bench`.
+use crate::Fail;
+use parafront_io::{write_pvtu, Field, FieldData, Piece, WriteOptions};
+use parafront_mesh::{PointId, TetMesh};
+use parafront_pipeline::Summary;
+use std::path::Path;
+
+/// Per-region lines: DDG, imbalance, tets per pass.
+pub fn print_parallel(sum: &Summary) {
+    for (r, st) in sum.parallel.iter().enumerate() {
+        let total: usize = st.pass_tets.iter().sum();
+        let share = |n: usize| 100.0 * n as f64 / total.max(1) as f64;
+        println!(
+            "region {}: {} parts; DDG {} tets, {} points ({} on the surface, {} new), growth {}{}, {:.3} s",
+            r + 1,
+            st.parts,
+            st.ddg_tets,
+            st.ddg_points,
+            st.ddg_surface_points,
+            st.ddg_points - st.ddg_surface_points,
+            st.ddg_growth,
+            if st.ddg_graded { " (graded field)" } else { " (per face)" },
+            st.ddg_seconds
+        );
+        println!(
+            "  imbalance (max/mean): predicted {:.3}, made in passes 1-3 {:.3}, held after redistribution {:.3}",
+            st.predicted_imbalance, st.made_imbalance, st.held_imbalance
+        );
+        println!(
+            "  tets per pass: {} ({:.2}%), {} ({:.2}%), {} ({:.2}%), {} ({:.2}%); {} tets of passes 1-3 peeled for pass 4",
+            st.pass_tets[0],
+            share(st.pass_tets[0]),
+            st.pass_tets[1],
+            share(st.pass_tets[1]),
+            st.pass_tets[2],
+            share(st.pass_tets[2]),
+            st.pass_tets[3],
+            share(st.pass_tets[3]),
+            st.peeled_tets
+        );
+        println!(
+            "  seconds per pass: {:.3}, {:.3}, {:.3}, {:.3}; critical path (one core per part) {:.3} s",
+            st.pass_seconds[0],
+            st.pass_seconds[1],
+            st.pass_seconds[2],
+            st.pass_seconds[3],
+            st.critical_path_seconds()
+        );
+    }
+}
+
+/// The partitioned mesh: a `.pvtu` and one `.vtu` per piece, with global
+/// point and cell ids, the owning part of each point, a ghost flag on the
+/// points another part owns, and the number of parts sharing each point.
+pub fn write_partitioned(
+    path: &Path,
+    mesh: &TetMesh,
+    sum: &Summary,
+    w: &WriteOptions,
+) -> Result<(), Fail> {
+    if sum.pieces.is_empty() {
+        return Err(Fail(2, "--pvtu needs --parts > 1".into()));
+    }
+    struct Arrays {
+        mesh: TetMesh,
+        gid: Vec<i64>,
+        ghost: Vec<u8>,
+        owner: Vec<i32>,
+        sharers: Vec<i32>,
+        cell_gid: Vec<i64>,
+        pass: Vec<i32>,
+    }
+    // Pieces are numbered per region; cells get offsets in region order.
+    let mut cell_base = 0i64;
+    let mut prev_part_count = 0usize;
+    let mut arrays = Vec::with_capacity(sum.pieces.len());
+    for (i, pc) in sum.pieces.iter().enumerate() {
+        let region_first = i % sum.parallel.first().map_or(1, |s| s.parts) == 0;
+        if region_first && i > 0 {
+            cell_base += prev_part_count as i64;
+            prev_part_count = 0;
+        }
+        prev_part_count += pc.tets.len();
+        let mut sharers = vec![0i32; pc.points.len()];
+        for list in &pc.shared {
+            for &p in list {
+                sharers[p as usize] += 1;
+            }
+        }
+        let region = mesh.region.first().copied().unwrap_or(0);
+        arrays.push(Arrays {
+            mesh: TetMesh {
+                points: pc.points.clone(),
+                tets: pc.tets.iter().map(|t| t.map(PointId)).collect(),
+                region: vec![region; pc.tets.len()],
+                ..Default::default()
+            },
+            gid: pc.gid.iter().map(|&g| g as i64).collect(),
+            ghost: pc
+                .owner
+                .iter()
+                .map(|&o| u8::from(o as usize != i % sum.parallel[0].parts))
+                .collect(),
+            owner: pc.owner.iter().map(|&o| o as i32).collect(),
+            sharers,
+            cell_gid: pc.tet_gid.iter().map(|&g| cell_base + g as i64).collect(),
+            pass: pc.tet_pass.iter().map(|&p| p as i32).collect(),
+        });
+    }
+    let pieces: Vec<Piece> = arrays
+        .iter()
+        .map(|a| Piece {
+            mesh: &a.mesh,
+            point_fields: vec![
+                Field::scalar("GlobalPointIds", FieldData::I64(&a.gid)),
+                Field::scalar("vtkGhostType", FieldData::U8(&a.ghost)),
+                Field::scalar("OwnerPart", FieldData::I32(&a.owner)),
+                Field::scalar("SharingParts", FieldData::I32(&a.sharers)),
+            ],
+            cell_fields: vec![
+                Field::scalar("GlobalCellIds", FieldData::I64(&a.cell_gid)),
+                Field::scalar("Pass", FieldData::I32(&a.pass)),
+            ],
+        })
+        .collect();
+    write_pvtu(path, &pieces, w)?;
+    Ok(())
+}
