@@ -62,6 +62,21 @@ enum Cmd {
         #[arg(long)]
         plot: Option<PathBuf>,
     },
+    /// Time the mesher over parts and threads: a table like the paper's
+    /// Tables 1 to 3, with the time per stage and pass, each pass's share
+    /// of the tets, the load imbalance and the critical path.
+    Bench {
+        surface: PathBuf,
+        /// Target element size.
+        #[arg(long)]
+        size: Option<f64>,
+        /// Part counts to run, comma separated.
+        #[arg(long, value_delimiter = ',', default_value = "1,2,8")]
+        parts: Vec<usize>,
+        /// Thread counts to run, comma separated.
+        #[arg(long, value_delimiter = ',', default_value = "1,2")]
+        threads: Vec<usize>,
+    },
     /// Convert a tet mesh between formats (.vtu, .msh, .mesh).
     Convert {
         input: PathBuf,
@@ -161,6 +176,12 @@ fn main() -> ExitCode {
             .map_err(Fail::from)
             .and_then(|s| run_mesh(&s, &surface.display().to_string(), &output, &mesh, &write)),
         Cmd::Check { surface } => run_check(&surface),
+        Cmd::Bench {
+            surface,
+            size,
+            parts,
+            threads,
+        } => parallel::run_bench(&surface, size, &parts, &threads),
         Cmd::Quality { mesh, plot } => run_quality(&mesh, plot.as_deref()),
         Cmd::Convert {
             input,
