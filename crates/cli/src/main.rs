@@ -279,7 +279,7 @@ fn run_mesh(s: &Surface, name: &str, out: &Path, a: &MeshArgs, w: &WriteArgs) ->
     parallel::print_parallel(&sum);
     println!("wrote {}", out.display());
     if let Some(p) = &a.pvtu {
-        parallel::write_partitioned(p, &mesh, &sum, &wopts)?;
+        parallel::write_partitioned(p, &sum, &wopts)?;
         println!("wrote {} ({} pieces)", p.display(), sum.pieces.len());
     }
     if let Some(p) = &a.plot {

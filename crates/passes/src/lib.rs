@@ -603,9 +603,9 @@ const MAX_PEEL: usize = 4;
 /// Pass 4: every part sends what is left of its front to part 0, which
 /// closes it with the serial front (recovery on). What passes 1 to 3 left
 /// are faces the front could not advance without recovery, and recovery
-/// can only remove tets of its own call: so when the serial front gets
-/// stuck, the parts remove the tets touching the left-over front (one
-/// layer per try) and send their faces along, giving it room.
+/// can only remove tets of its own call: so the parts first remove the
+/// tets touching the left-over front (one layer, one more per try when the
+/// serial front still gets stuck) and send their faces along.
 /// Returns the tets made and the tets removed.
 fn serial_pass<C: Comm>(
     parts: &mut [Part],
@@ -625,11 +625,11 @@ fn serial_pass<C: Comm>(
         return Ok((0, 0));
     }
     let mut removed = 0;
-    let mut peel = 0;
+    // The front left over is what the passes could not advance: a first
+    // try without room spends long in recovery, so peel from the start.
+    let mut peel = 1;
     loop {
-        if peel > 0 {
-            removed += peel_layer(parts, comm, &mut hole);
-        }
+        removed += peel_layer(parts, comm, &mut hole);
         let mut index: FxHashMap<u32, u32> = FxHashMap::default();
         let (mut pts, mut hs, mut gids) = (Vec::new(), Vec::new(), Vec::new());
         let faces: Vec<[u32; 3]> = hole
