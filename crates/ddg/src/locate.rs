@@ -89,7 +89,7 @@ impl Bins {
         let mut c = [0usize; 3];
         for k in 0..3 {
             let x = (p[k] - self.min[k]) * self.inv;
-            if !(x >= 0.0) || x >= self.n[k] as f64 + 1e-9 {
+            if x.is_nan() || x < 0.0 || x >= self.n[k] as f64 + 1e-9 {
                 return None;
             }
             c[k] = (x as usize).min(self.n[k] - 1);
@@ -253,15 +253,14 @@ impl Interfaces {
     pub fn crosses(&self, k: u32, a: P3, b: P3) -> bool {
         let mut bb = Aabb { min: a, max: a };
         bb.grow(b);
-        let hit = !self.bins.visit(&bb, |x| {
+        !self.bins.visit(&bb, |x| {
             let s = self.sides[x as usize];
             if s[0] != k && s[1] != k {
                 return true;
             }
             let [p, q, r] = self.faces[x as usize];
             matches!(segment_triangle(a, b, p, q, r), SegTri::Disjoint)
-        });
-        hit
+        })
     }
 }
 

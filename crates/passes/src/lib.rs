@@ -233,7 +233,7 @@ pub fn mesh_parallel<C: Comm>(
         st.pass_tets[j] = tets.iter().sum();
         st.part_seconds[j] = secs;
         st.pass_seconds[j] = t0.elapsed().as_secs_f64();
-        if std::env::var_os("PARAFRONT_DEBUG_PASS4").is_some() {
+        if std::env::var_os("PARAFRONT_DEBUG_PASSES").is_some() {
             let fr: Vec<usize> = parts.iter().map(|p| p.front.len()).collect();
             eprintln!("pass {} tets {:?} front left {:?}", j + 1, tets, fr);
         }
@@ -517,7 +517,7 @@ fn close_pockets(
         }
         let hm = hsum / faces.len() as f64;
         let pocket = vol < 0.0 && -vol <= faces.len() as f64 * hm * hm * hm;
-        if std::env::var_os("PARAFRONT_DEBUG_PASS4").is_some() && closed {
+        if std::env::var_os("PARAFRONT_DEBUG_PASSES").is_some() && closed {
             eprintln!("pocket: {} faces, vol {vol:.3e}, h {hm:.3e}, taken {}", faces.len(), pocket && faces.len() <= MAX_POCKET);
         }
         if closed && pocket && faces.len() <= MAX_POCKET {
