@@ -1,5 +1,6 @@
 //! `parafront`: the command line. A thin layer: each subcommand parses its
 //! flags into the library's option structs and calls one function.
+mod parallel;
 mod plot;
 
 use clap::{Args, Parser, Subcommand};
@@ -65,6 +66,21 @@ enum Cmd {
         #[arg(long)]
         before: Option<PathBuf>,
     },
+    /// Time the mesher over parts and threads: a table like the paper's
+    /// Tables 1 to 3, with the time per stage and pass, each pass's share
+    /// of the tets, the load imbalance and the critical path.
+    Bench {
+        surface: PathBuf,
+        /// Target element size.
+        #[arg(long)]
+        size: Option<f64>,
+        /// Part counts to run, comma separated.
+        #[arg(long, value_delimiter = ',', default_value = "1,2,8")]
+        parts: Vec<usize>,
+        /// Thread counts to run, comma separated.
+        #[arg(long, value_delimiter = ',', default_value = "1,2")]
+        threads: Vec<usize>,
+    },
     /// Convert a tet mesh between formats (.vtu, .msh, .mesh).
     Convert {
         input: PathBuf,
@@ -95,6 +111,16 @@ struct MeshArgs {
     /// Worker threads (default: all cores).
     #[arg(long)]
     threads: Option<usize>,
+    /// Parts of the parallel mesher (the paper's nproc; 1: serial front).
+    #[arg(long, default_value_t = 1)]
+    parts: usize,
+    /// Growth factor of the domain-defining grid (§5).
+    #[arg(long)]
+    ddg_growth: Option<f64>,
+    /// With --parts > 1, also write the partitioned mesh: this .pvtu and
+    /// one .vtu per part beside it.
+    #[arg(long)]
+    pvtu: Option<PathBuf>,
     /// Also plot the quality histograms to this file (.svg or .png);
     /// with improvement on, before and after.
     #[arg(long)]
@@ -163,6 +189,12 @@ fn main() -> ExitCode {
             .map_err(Fail::from)
             .and_then(|s| run_mesh(&s, &surface.display().to_string(), &output, &mesh, &write)),
         Cmd::Check { surface } => run_check(&surface),
+        Cmd::Bench {
+            surface,
+            size,
+            parts,
+            threads,
+        } => parallel::run_bench(&surface, size, &parts, &threads),
         Cmd::Quality { mesh, plot, before } => {
             run_quality(&mesh, plot.as_deref(), before.as_deref())
         }
@@ -218,6 +250,19 @@ fn mesh_options(a: &MeshArgs) -> Result<MeshOptions, Fail> {
     if let Some(l) = a.optimize {
         o.optimize = l;
     }
+    if a.parts == 0 {
+        return Err(Fail(2, "--parts must be at least 1".into()));
+    }
+    o.parts = a.parts;
+    o.ddg_growth = a.ddg_growth.unwrap_or(0.0);
+    if a.pvtu.is_some() && o.optimize > 0 {
+        // The pieces are the generation's partition (§8); improvement
+        // (§9) changes the mesh after it and does not renumber them yet.
+        return Err(Fail(
+            2,
+            "--pvtu writes the mesh as the parallel passes left it: add --optimize 0".into(),
+        ));
+    }
     Ok(o)
 }
 
@@ -263,7 +308,12 @@ fn run_mesh(s: &Surface, name: &str, out: &Path, a: &MeshArgs, w: &WriteArgs) ->
     sum.stages.push(("write", t0.elapsed().as_secs_f64()));
     let q = parafront_pipeline::quality_report(&mesh, s, &opts);
     print_summary(&sum, &q);
+    parallel::print_parallel(&sum);
     println!("wrote {}", out.display());
+    if let Some(p) = &a.pvtu {
+        parallel::write_partitioned(p, &sum, &wopts)?;
+        println!("wrote {} ({} pieces)", p.display(), sum.pieces.len());
+    }
     if let Some(p) = &a.plot {
         plot::plot_histograms(&q, sum.quality_before.as_ref(), p)?;
         println!("wrote {}", p.display());

@@ -9,6 +9,7 @@ pub use regions::{material_regions, RegionFront};
 
 use parafront_front::{advance, FrontError, FrontInput, FrontOptions, SizeMode};
 use parafront_mesh::{CheckError, PointId, QualityReport, TetMesh};
+use parafront_passes::{mesh_parallel, ParOptions, ParStats, PassError, Piece};
 use parafront_size::{SizeError, SizeField, SizeOptions, Sizing};
 use parafront_surface::validate::{validate, Report};
 use parafront_surface::Surface;
@@ -27,6 +28,14 @@ pub struct MeshOptions {
     /// Worker threads (0: all cores).
     #[serde(default)]
     pub threads: usize,
+    /// Parts of the parallel mesher (the paper's nproc); 1 runs the serial
+    /// front. With more, each region goes through the DDG, its partition
+    /// and the inside-out passes (§5 to §8).
+    #[serde(default = "one")]
+    pub parts: usize,
+    /// DDG growth factor `c_i` (§5); 0 takes the default (1.6).
+    #[serde(default)]
+    pub ddg_growth: f64,
     /// Skip the final validity check (not recommended; it is cheap).
     #[serde(default)]
     pub no_check: bool,
@@ -54,12 +63,18 @@ impl Default for MeshOptions {
         MeshOptions {
             size: SizeOptions::default(),
             threads: 0,
+            parts: 1,
+            ddg_growth: 0.0,
             no_check: false,
             debug_partial: false,
             progress: None,
             optimize: default_optimize(),
         }
     }
+}
+
+fn one() -> usize {
+    1
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -70,6 +85,8 @@ pub enum MeshError {
     Size(#[from] SizeError),
     #[error("region {region}: {source}")]
     Front { region: usize, source: FrontError },
+    #[error("region {region}: {source}")]
+    Parallel { region: usize, source: PassError },
     #[error("the generated mesh failed its check (this is a bug in parafront): {0}")]
     Check(#[from] CheckError),
     #[error("{0}")]
@@ -90,6 +107,11 @@ pub struct Summary {
     pub quality_before: Option<QualityReport>,
     /// What improvement did, per operation (when it ran).
     pub improve: Option<parafront_improve::ImproveStats>,
+    /// Per region, what the parallel passes did (empty with one part).
+    pub parallel: Vec<ParStats>,
+    /// The partitioned mesh, one piece per region and part, with global
+    /// ids in the merged mesh's numbering (empty with one part).
+    pub pieces: Vec<Piece>,
 }
 
 impl Summary {
@@ -130,7 +152,10 @@ pub fn mesh_surface(s: &Surface, opts: &MeshOptions) -> Result<(TetMesh, Summary
         ..Default::default()
     };
     let field = |p| sizing.size(p);
-    for (r, rf) in fronts.iter().enumerate() {
+    if opts.parts > 1 {
+        mesh_parts(s, &fronts, &sizing, opts, &mut mesh, &mut sum)?;
+    }
+    for (r, rf) in fronts.iter().enumerate().filter(|_| opts.parts <= 1) {
         let input = FrontInput {
             points: rf.points.iter().map(|&i| s.points[i as usize]).collect(),
             point_size: rf
@@ -172,7 +197,9 @@ pub fn mesh_surface(s: &Surface, opts: &MeshOptions) -> Result<(TetMesh, Summary
         sum.recovery_rounds += res.stats.recovery_rounds;
         sum.tets_removed += res.stats.tets_removed;
     }
-    sum.stages.push(("front", t0.elapsed().as_secs_f64()));
+    if opts.parts <= 1 {
+        sum.stages.push(("front", t0.elapsed().as_secs_f64()));
+    }
 
     if opts.optimize > 0 {
         sum.quality_before = Some(QualityReport::new(&mesh));
@@ -187,6 +214,9 @@ pub fn mesh_surface(s: &Surface, opts: &MeshOptions) -> Result<(TetMesh, Summary
             .map_err(|e| MeshError::Topology(e.to_string()))?;
         sum.improve = Some(st);
         sum.stages.push(("improve", t0.elapsed().as_secs_f64()));
+        // The pieces number the mesh before improvement, which swaps and
+        // collapses have changed: none is better than a stale one.
+        sum.pieces.clear();
     }
 
     let t0 = Instant::now();
@@ -211,6 +241,95 @@ pub fn mesh_surface(s: &Surface, opts: &MeshOptions) -> Result<(TetMesh, Summary
     sum.points = mesh.points.len();
     sum.regions = fronts.len();
     Ok((mesh, sum))
+}
+
+/// The parallel mesher (§5 to §8) on each region, on the threads backend;
+/// the merged result goes into `mesh` like the serial front's.
+fn mesh_parts(
+    s: &Surface,
+    fronts: &[RegionFront],
+    sizing: &Sizing,
+    opts: &MeshOptions,
+    mesh: &mut TetMesh,
+    sum: &mut Summary,
+) -> Result<(), MeshError> {
+    let field = |p| sizing.size(p);
+    let popts = ParOptions {
+        parts: opts.parts,
+        growth: if opts.ddg_growth > 0.0 {
+            opts.ddg_growth
+        } else {
+            parafront_ddg::DEFAULT_GROWTH
+        },
+        ..ParOptions::default()
+    };
+    let comm = parafront_comm::Threads::new(opts.parts);
+    let mut stage = [0.0f64; 7];
+    for (r, rf) in fronts.iter().enumerate() {
+        let pts: Vec<_> = rf.points.iter().map(|&i| s.points[i as usize]).collect();
+        let hs: Vec<f64> = rf
+            .points
+            .iter()
+            .map(|&i| sizing.surface_point_sizes()[i as usize])
+            .collect();
+        let out = mesh_parallel(&pts, &hs, &rf.faces, &field, &popts, &comm).map_err(|e| {
+            MeshError::Parallel {
+                region: r,
+                source: e,
+            }
+        })?;
+        let n_in = rf.points.len();
+        let base = mesh.points.len() as u32;
+        let map = |p: u32| {
+            if (p as usize) < n_in {
+                rf.points[p as usize]
+            } else {
+                base + p - n_in as u32
+            }
+        };
+        mesh.points.extend_from_slice(&out.points[n_in..]);
+        mesh.tets
+            .extend(out.tets.iter().map(|t| t.map(|p| PointId(map(p)))));
+        mesh.region
+            .extend(std::iter::repeat_n(rf.region_id, out.tets.len()));
+        let st = &out.stats;
+        for (k, x) in [
+            st.ddg_seconds,
+            st.partition_seconds,
+            st.pass_seconds[0],
+            st.pass_seconds[1],
+            st.pass_seconds[2],
+            st.pass_seconds[3],
+            st.redistribute_seconds,
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            stage[k] += x;
+        }
+        for mut pc in out.pieces {
+            for g in &mut pc.gid {
+                *g = map(*g);
+            }
+            sum.pieces.push(pc);
+        }
+        sum.parallel.push(out.stats);
+    }
+    for (name, x) in [
+        "ddg",
+        "partition",
+        "pass 1",
+        "pass 2",
+        "pass 3",
+        "pass 4",
+        "redistribute",
+    ]
+    .into_iter()
+    .zip(stage)
+    {
+        sum.stages.push((name, x));
+    }
+    Ok(())
 }
 
 /// Quality of `mesh` with edge lengths measured against the size field

@@ -1,0 +1,218 @@
+//! The parallel mesher's report, its partitioned output and `bench`.
+use crate::Fail;
+use parafront_io::{write_pvtu, Field, FieldData, Piece, WriteOptions};
+use parafront_mesh::{PointId, TetMesh};
+use parafront_pipeline::Summary;
+use std::path::Path;
+
+/// Per-region lines: DDG, imbalance, tets per pass.
+pub fn print_parallel(sum: &Summary) {
+    for (r, st) in sum.parallel.iter().enumerate() {
+        let total: usize = st.pass_tets.iter().sum();
+        let share = |n: usize| 100.0 * n as f64 / total.max(1) as f64;
+        println!(
+            "region {}: {} parts; DDG {} tets, {} points ({} on the surface, {} new), growth {}{}, {:.3} s",
+            r + 1,
+            st.parts,
+            st.ddg_tets,
+            st.ddg_points,
+            st.ddg_surface_points,
+            st.ddg_points - st.ddg_surface_points,
+            st.ddg_growth,
+            if st.ddg_graded { " (graded field)" } else { " (per face)" },
+            st.ddg_seconds
+        );
+        println!(
+            "  imbalance (max/mean): predicted {:.3}, made in passes 1-3 {:.3}, held after redistribution {:.3}",
+            st.predicted_imbalance, st.made_imbalance, st.held_imbalance
+        );
+        println!(
+            "  tets per pass: {} ({:.2}%), {} ({:.2}%), {} ({:.2}%), {} ({:.2}%); {} tets of passes 1-3 peeled for pass 4",
+            st.pass_tets[0],
+            share(st.pass_tets[0]),
+            st.pass_tets[1],
+            share(st.pass_tets[1]),
+            st.pass_tets[2],
+            share(st.pass_tets[2]),
+            st.pass_tets[3],
+            share(st.pass_tets[3]),
+            st.peeled_tets
+        );
+        println!(
+            "  seconds per pass: {:.3}, {:.3}, {:.3}, {:.3}; critical path (one core per part) {:.3} s",
+            st.pass_seconds[0],
+            st.pass_seconds[1],
+            st.pass_seconds[2],
+            st.pass_seconds[3],
+            st.critical_path_seconds()
+        );
+    }
+}
+
+/// The partitioned mesh: a `.pvtu` and one `.vtu` per piece, with global
+/// point and cell ids, the owning part of each point, a ghost flag on the
+/// points another part owns, and the number of parts sharing each point.
+pub fn write_partitioned(path: &Path, sum: &Summary, w: &WriteOptions) -> Result<(), Fail> {
+    if sum.pieces.is_empty() {
+        return Err(Fail(2, "--pvtu needs --parts > 1".into()));
+    }
+    struct Arrays {
+        mesh: TetMesh,
+        gid: Vec<i64>,
+        ghost: Vec<u8>,
+        owner: Vec<i32>,
+        sharers: Vec<i32>,
+        cell_gid: Vec<i64>,
+        pass: Vec<i32>,
+    }
+    // Pieces come region by region, `parts` per region; global cell ids
+    // are per region, so each region starts after the ones before it.
+    let parts = sum.parallel[0].parts;
+    let mut region_base = vec![0i64; sum.parallel.len() + 1];
+    for (r, st) in sum.parallel.iter().enumerate() {
+        region_base[r + 1] = region_base[r] + st.pass_tets.iter().sum::<usize>() as i64;
+    }
+    let mut arrays = Vec::with_capacity(sum.pieces.len());
+    for (i, pc) in sum.pieces.iter().enumerate() {
+        let (r, k) = (i / parts, i % parts);
+        let cell_base = region_base[r];
+        let mut sharers = vec![0i32; pc.points.len()];
+        for list in &pc.shared {
+            for &p in list {
+                sharers[p as usize] += 1;
+            }
+        }
+        let region = r as u32 + 1;
+        arrays.push(Arrays {
+            mesh: TetMesh {
+                points: pc.points.clone(),
+                tets: pc.tets.iter().map(|t| t.map(PointId)).collect(),
+                region: vec![region; pc.tets.len()],
+                ..Default::default()
+            },
+            gid: pc.gid.iter().map(|&g| g as i64).collect(),
+            ghost: pc
+                .owner
+                .iter()
+                .map(|&o| u8::from(o as usize != k))
+                .collect(),
+            owner: pc.owner.iter().map(|&o| o as i32).collect(),
+            sharers,
+            cell_gid: pc.tet_gid.iter().map(|&g| cell_base + g as i64).collect(),
+            pass: pc.tet_pass.iter().map(|&p| p as i32).collect(),
+        });
+    }
+    let pieces: Vec<Piece> = arrays
+        .iter()
+        .map(|a| Piece {
+            mesh: &a.mesh,
+            point_fields: vec![
+                Field::scalar("GlobalPointIds", FieldData::I64(&a.gid)),
+                Field::scalar("vtkGhostType", FieldData::U8(&a.ghost)),
+                Field::scalar("OwnerPart", FieldData::I32(&a.owner)),
+                Field::scalar("SharingParts", FieldData::I32(&a.sharers)),
+            ],
+            cell_fields: vec![
+                Field::scalar("GlobalCellIds", FieldData::I64(&a.cell_gid)),
+                Field::scalar("Pass", FieldData::I32(&a.pass)),
+            ],
+        })
+        .collect();
+    write_pvtu(path, &pieces, w)?;
+    Ok(())
+}
+
+/// `parafront bench`: every (parts, threads) pair on one surface.
+pub fn run_bench(
+    path: &Path,
+    size: Option<f64>,
+    parts: &[usize],
+    threads: &[usize],
+) -> Result<(), Fail> {
+    let s = parafront_surface::read::read_surface(path)?;
+    println!(
+        "{}: {} points, {} triangles",
+        path.display(),
+        s.points.len(),
+        s.tris.len()
+    );
+    println!(
+        "{:>5} {:>5} {:>5} {:>9} {:>9} {:>11} {:>11} | {:>7} {:>7} {:>7} {:>7} {:>7} {:>7} | {:>6} {:>6} {:>6} {:>6} | {:>6} {:>6} {:>8}",
+        "nproc", "nprol", "ncore", "nelem", "CPU s", "AbsSpeed", "RelSpeed",
+        "ddg", "part", "pass1", "pass2", "pass3", "pass4",
+        "%p1", "%p2", "%p3", "%p4", "imbP", "imbH", "crit s"
+    );
+    let mut base: Option<f64> = None;
+    for &p in parts {
+        for &t in threads {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(t.max(1))
+                .build()
+                .map_err(|e| Fail(2, e.to_string()))?;
+            let mut o = parafront_pipeline::MeshOptions {
+                parts: p.max(1),
+                threads: t,
+                ..Default::default()
+            };
+            o.size.h = size;
+            let t0 = std::time::Instant::now();
+            let (m, sum) = pool
+                .install(|| parafront_pipeline::mesh_surface(&s, &o))
+                .map_err(|e| Fail(1, format!("parts {p}, threads {t}: {e}")))?;
+            let secs = t0.elapsed().as_secs_f64();
+            let n = m.tets.len();
+            let cores = t.max(1);
+            let nprol = (cores / p.max(1)).max(1);
+            let st = sum.parallel.first();
+            let share = |k: usize| {
+                st.map_or(if k == 0 { 100.0 } else { 0.0 }, |_| {
+                    let tot: usize = sum
+                        .parallel
+                        .iter()
+                        .map(|x| x.pass_tets.iter().sum::<usize>())
+                        .sum();
+                    100.0 * sum.parallel.iter().map(|x| x.pass_tets[k]).sum::<usize>() as f64
+                        / tot.max(1) as f64
+                })
+            };
+            let crit: f64 = if sum.parallel.is_empty() {
+                secs
+            } else {
+                sum.total_seconds()
+                    - sum
+                        .parallel
+                        .iter()
+                        .map(|x| x.pass_seconds[..3].iter().sum::<f64>())
+                        .sum::<f64>()
+                    + sum
+                        .parallel
+                        .iter()
+                        .map(|x| {
+                            x.part_seconds
+                                .iter()
+                                .map(|v| v.iter().cloned().fold(0.0, f64::max))
+                                .sum::<f64>()
+                        })
+                        .sum::<f64>()
+            };
+            base.get_or_insert(secs);
+            println!(
+                "{:>5} {:>5} {:>5} {:>9} {:>9.2} {:>11.0} {:>11.0} | {:>7.2} {:>7.2} {:>7.2} {:>7.2} {:>7.2} {:>7.2} | {:>6.2} {:>6.2} {:>6.2} {:>6.2} | {:>6.3} {:>6.3} {:>8.2}",
+                p, nprol, cores, n, secs, n as f64 / secs, n as f64 / secs / cores as f64,
+                sum.seconds("ddg") + 0.0, sum.seconds("partition") + 0.0,
+                if p > 1 { sum.seconds("pass 1") } else { sum.seconds("front") } + 0.0,
+                sum.seconds("pass 2") + 0.0, sum.seconds("pass 3") + 0.0, sum.seconds("pass 4") + 0.0,
+                share(0), share(1), share(2), share(3),
+                st.map_or(1.0, |x| x.predicted_imbalance), st.map_or(1.0, |x| x.held_imbalance),
+                crit
+            );
+        }
+    }
+    println!(
+        "imbP: predicted (DDG weights), imbH: tets held after redistribution (max/mean, region 1);"
+    );
+    println!(
+        "crit s: the run with each parallel pass timed by its slowest part (one core per part)."
+    );
+    Ok(())
+}

@@ -1,0 +1,822 @@
+//! The parallel mesher of one closed front (paper §5 to §8): the DDG,
+//! its balanced partition, the inside-out passes on shifted partitions
+//! (pass 1 on DDG0, pass 2 with layers taken from higher neighbours,
+//! pass 3 from lower ones, pass 4 serial) and the redistribution of the
+//! pieces.
+//!
+//! Every part keeps its own points, tets and front ([`Part`] is private to
+//! this module and only ever touched by the closure of its own part); parts
+//! see each other's data only through the messages of a [`Comm`].
+
+mod redistribute;
+
+pub use redistribute::Piece;
+
+use parafront_comm::Comm;
+use parafront_ddg::{self as ddg, Ddg, Interfaces, Locator, PartFilter, Shift};
+use parafront_front::{advance, Everywhere, FrontError, FrontInput, FrontOptions, SizeMode};
+use parafront_geom::{Aabb, P3};
+use rayon::prelude::*;
+use rustc_hash::FxHashMap;
+use std::time::Instant;
+
+/// Options of the parallel mesher.
+#[derive(Clone, Debug)]
+pub struct ParOptions {
+    /// Number of parts (the paper's nproc).
+    pub parts: usize,
+    /// DDG growth factor `c_i` (§5).
+    pub growth: f64,
+    /// DDG layers moved across each wall in passes 2 and 3 (§7: 1 or 2).
+    pub layers: usize,
+}
+
+impl Default for ParOptions {
+    fn default() -> Self {
+        ParOptions {
+            parts: 2,
+            growth: ddg::DEFAULT_GROWTH,
+            layers: 2,
+        }
+    }
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum PassError {
+    #[error("domain-defining grid: {0}")]
+    Ddg(#[from] ddg::DdgError),
+    #[error("pass {pass}, part {part}: {source}")]
+    Pass {
+        pass: u8,
+        part: usize,
+        source: FrontError,
+    },
+    #[error("redistribution: {0}")]
+    Redistribute(String),
+}
+
+/// What the passes did, for the summary and the benchmark table.
+#[derive(Clone, Debug, Default)]
+pub struct ParStats {
+    pub parts: usize,
+    pub ddg_tets: usize,
+    pub ddg_points: usize,
+    pub ddg_surface_points: usize,
+    pub ddg_growth: f64,
+    /// The DDG used the graded field (the per-face growth got stuck).
+    pub ddg_graded: bool,
+    pub ddg_seconds: f64,
+    pub partition_seconds: f64,
+    /// Max over mean of the predicted (DDG weight) load.
+    pub predicted_imbalance: f64,
+    /// Max over mean of the tets each part made in pass 1 to 3, and of the
+    /// tets each part holds after redistribution.
+    pub made_imbalance: f64,
+    pub held_imbalance: f64,
+    /// Tets of passes 1 to 3 removed to give pass 4 room.
+    pub peeled_tets: usize,
+    /// Tets made in passes 1 to 4 (those in the final mesh for 1 to 3).
+    pub pass_tets: [usize; 4],
+    /// Wall seconds of passes 1 to 4 (message building included).
+    pub pass_seconds: [f64; 4],
+    /// Per pass 1 to 3, each part's seconds inside the front.
+    pub part_seconds: [Vec<f64>; 3],
+    pub redistribute_seconds: f64,
+}
+
+impl ParStats {
+    /// Seconds on the critical path if every part had its own core: each
+    /// parallel pass takes as long as its slowest part.
+    pub fn critical_path_seconds(&self) -> f64 {
+        self.ddg_seconds
+            + self.partition_seconds
+            + self
+                .part_seconds
+                .iter()
+                .map(|v| v.iter().cloned().fold(0.0, f64::max))
+                .sum::<f64>()
+            + self.pass_seconds[3]
+            + self.redistribute_seconds
+    }
+}
+
+/// The merged mesh and the partitioned one.
+#[derive(Clone, Debug, Default)]
+pub struct ParOutput {
+    /// Input points first (same ids), then the new points in global order.
+    pub points: Vec<P3>,
+    /// Tets in global order: by part after redistribution, then local order.
+    pub tets: Vec<[u32; 4]>,
+    /// Pass (1 to 4) that made each tet.
+    pub tet_pass: Vec<u8>,
+    pub pieces: Vec<Piece>,
+    pub stats: ParStats,
+}
+
+/// A point as it travels in a message: its global id, where it is, its size.
+#[derive(Clone, Copy, Debug)]
+struct Rec {
+    gid: u32,
+    p: P3,
+    h: f64,
+}
+
+/// A front face in a message: owned (the part advances it) or context
+/// (the part only has to know it is there).
+struct FaceMsg {
+    owned: bool,
+    v: [Rec; 3],
+}
+
+/// One part's local data.
+#[derive(Default)]
+struct Part {
+    pts: Vec<P3>,
+    size: Vec<f64>,
+    gid: Vec<u32>,
+    index: FxHashMap<u32, u32>,
+    /// Local ids.
+    tets: Vec<[u32; 4]>,
+    tet_pass: Vec<u8>,
+    /// The faces this part holds, local ids.
+    front: Vec<[u32; 3]>,
+}
+
+impl Part {
+    fn local(&mut self, r: Rec) -> u32 {
+        if let Some(&i) = self.index.get(&r.gid) {
+            return i;
+        }
+        let i = self.pts.len() as u32;
+        self.pts.push(r.p);
+        self.size.push(r.h);
+        self.gid.push(r.gid);
+        self.index.insert(r.gid, i);
+        i
+    }
+    fn rec(&self, i: u32) -> Rec {
+        Rec {
+            gid: self.gid[i as usize],
+            p: self.pts[i as usize],
+            h: self.size[i as usize],
+        }
+    }
+}
+
+/// What one part's front call gave back, before new points get global ids.
+struct Made {
+    res: Option<parafront_front::FrontResult>,
+    /// Global ids of the input points.
+    input_gid: Vec<u32>,
+    /// Input points inside this part (conservative assignment).
+    input_ok: Vec<bool>,
+    seconds: f64,
+}
+
+/// Meshes the region bounded by `faces` (normals inward) on `comm.parts()`
+/// parts. `size` is the fine size field; `point_size` the size at each
+/// input point.
+pub fn mesh_parallel<C: Comm>(
+    points: &[P3],
+    point_size: &[f64],
+    faces: &[[u32; 3]],
+    size: &(dyn Fn(P3) -> f64 + Sync),
+    opts: &ParOptions,
+    comm: &C,
+) -> Result<ParOutput, PassError> {
+    let np = comm.parts();
+    let mut st = ParStats {
+        parts: np,
+        ..Default::default()
+    };
+    // §5 step 1: the DDG (replicated: it is small).
+    let d = ddg::build(
+        points.to_vec(),
+        point_size.to_vec(),
+        faces.to_vec(),
+        opts.growth,
+    )
+    .map_err(PassError::Ddg)?;
+    st.ddg_tets = d.tets.len();
+    st.ddg_points = d.points.len();
+    st.ddg_surface_points = d.n_input;
+    st.ddg_growth = d.growth;
+    st.ddg_graded = d.mode == ddg::DdgMode::Graded;
+    st.ddg_seconds = d.seconds;
+
+    // §6 step 2: weights and the balanced split.
+    let t0 = Instant::now();
+    let loc = Locator::new(&d);
+    let w = ddg::tet_weights(&d, size);
+    let part0 = ddg::rcb(&d, &w, np);
+    st.predicted_imbalance = ddg::imbalance(&part0, &w, np);
+    let part2 = ddg::shifted(&d, &part0, Shift::FromHigher, opts.layers);
+    let part3 = ddg::shifted(&d, &part0, Shift::FromLower, opts.layers);
+    st.partition_seconds = t0.elapsed().as_secs_f64();
+
+    // The input front starts on part 0 (the reader); pass 1 sends it out.
+    let mut parts: Vec<Part> = (0..np).map(|_| Part::default()).collect();
+    for f in faces {
+        let v = f.map(|i| {
+            parts[0].local(Rec {
+                gid: i,
+                p: points[i as usize],
+                h: point_size[i as usize],
+            })
+        });
+        parts[0].front.push(v);
+    }
+    let mut next_gid = points.len() as u32;
+    let mut made_per_part = vec![0usize; np];
+
+    // §7 step 3, passes 1 to 3.
+    for (j, part_of) in [&part0, &part2, &part3].into_iter().enumerate() {
+        let t0 = Instant::now();
+        let walls = Interfaces::new(&d, part_of);
+        let (tets, secs) = parallel_pass(
+            &mut parts,
+            comm,
+            &d,
+            &loc,
+            &walls,
+            part_of,
+            size,
+            j as u8 + 1,
+            &mut next_gid,
+        )?;
+        for (k, &n) in tets.iter().enumerate() {
+            made_per_part[k] += n;
+        }
+        st.pass_tets[j] = tets.iter().sum();
+        st.part_seconds[j] = secs;
+        st.pass_seconds[j] = t0.elapsed().as_secs_f64();
+        if std::env::var_os("PARAFRONT_DEBUG_PASSES").is_some() {
+            let fr: Vec<usize> = parts.iter().map(|p| p.front.len()).collect();
+            eprintln!("pass {} tets {:?} front left {:?}", j + 1, tets, fr);
+        }
+    }
+    let mean = made_per_part.iter().sum::<usize>() as f64 / np as f64;
+    st.made_imbalance = if mean > 0.0 {
+        *made_per_part.iter().max().unwrap() as f64 / mean
+    } else {
+        1.0
+    };
+
+    // Pass 4: what is left, serially on part 0.
+    let t0 = Instant::now();
+    let (made4, removed) = serial_pass(&mut parts, comm, size, &mut next_gid)?;
+    st.pass_tets[3] = made4;
+    st.peeled_tets = removed;
+    st.pass_seconds[3] = t0.elapsed().as_secs_f64();
+
+    // §8 step 4.
+    let t0 = Instant::now();
+    let out = redistribute::run(parts, comm, &loc, &part0, points, next_gid)?;
+    st.redistribute_seconds = t0.elapsed().as_secs_f64();
+    st.pass_tets = [0; 4];
+    for &p in &out.tet_pass {
+        st.pass_tets[p as usize - 1] += 1;
+    }
+    let held: Vec<usize> = out.pieces.iter().map(|p| p.tets.len()).collect();
+    let mean = held.iter().sum::<usize>() as f64 / np as f64;
+    st.held_imbalance = if mean > 0.0 {
+        *held.iter().max().unwrap() as f64 / mean
+    } else {
+        1.0
+    };
+    Ok(ParOutput { stats: st, ..out })
+}
+
+/// One parallel pass on partition `part_of`: send each front face to the
+/// part that owns its three points, and a copy to every part whose region
+/// box it meets (so that each part knows every face bounding its region);
+/// every part advances its faces; new points get global ids. Returns the
+/// tets and the front seconds of each part.
+#[allow(clippy::too_many_arguments)]
+fn parallel_pass<C: Comm>(
+    parts: &mut [Part],
+    comm: &C,
+    d: &Ddg,
+    loc: &Locator,
+    walls: &Interfaces,
+    part_of: &[u32],
+    size: &(dyn Fn(P3) -> f64 + Sync),
+    pass: u8,
+    next_gid: &mut u32,
+) -> Result<(Vec<usize>, Vec<f64>), PassError> {
+    let np = parts.len();
+    let mut boxes = vec![Aabb::EMPTY; np];
+    for (t, &k) in part_of.iter().enumerate() {
+        boxes[k as usize] = boxes[k as usize].union(&Aabb::from_points(d.tet_points(t).iter()));
+    }
+    let boxes: Vec<Aabb> = boxes
+        .iter()
+        .map(|b| {
+            if b.is_empty() {
+                *b
+            } else {
+                b.inflated(1e-9 * b.diagonal())
+            }
+        })
+        .collect();
+
+    // Each holder sorts its faces out.
+    let outboxes: Vec<Vec<(u32, FaceMsg)>> = parts
+        .par_iter_mut()
+        .map(|part| {
+            let mut owner: Vec<Option<Option<u32>>> = vec![None; part.pts.len()];
+            let mut out = Vec::new();
+            let mut keep = Vec::new();
+            for &f in &part.front {
+                let o = f.map(|i| {
+                    *owner[i as usize]
+                        .get_or_insert_with(|| loc.owner(part.pts[i as usize], part_of))
+                });
+                let own = if o[0].is_some() && o[0] == o[1] && o[1] == o[2] {
+                    o[0]
+                } else {
+                    None
+                };
+                let v = f.map(|i| part.rec(i));
+                let fb = Aabb::from_points(v.iter().map(|r| &r.p));
+                for (q, b) in boxes.iter().enumerate() {
+                    if Some(q as u32) != own && b.overlaps(&fb) {
+                        out.push((q as u32, FaceMsg { owned: false, v }));
+                    }
+                }
+                match own {
+                    Some(k) => out.push((k, FaceMsg { owned: true, v })),
+                    None => keep.push(f),
+                }
+            }
+            part.front = keep;
+            out
+        })
+        .collect();
+    let inboxes = comm.exchange(outboxes);
+
+    // Every part meshes inside its region.
+    let made: Vec<Made> = inboxes
+        .into_par_iter()
+        .enumerate()
+        .map(|(k, inbox)| front_call(inbox, k as u32, loc, walls, part_of, size))
+        .collect::<Result<_, (usize, FrontError)>>()
+        .map_err(|(part, source)| PassError::Pass { pass, part, source })?;
+
+    // Global ids for the new points: an all-gather of the counts.
+    let counts = comm.all_gather(
+        made.iter()
+            .map(|m| {
+                m.res
+                    .as_ref()
+                    .map_or(0, |r| r.points.len() - m.input_gid.len()) as u32
+            })
+            .collect(),
+    );
+    let mut base = Vec::with_capacity(np);
+    let mut acc = *next_gid;
+    for c in &counts {
+        base.push(acc);
+        acc += c;
+    }
+    *next_gid = acc;
+    let secs: Vec<f64> = made.iter().map(|m| m.seconds).collect();
+    let tets: Vec<usize> = parts
+        .par_iter_mut()
+        .zip(made)
+        .zip(base)
+        .map(|((part, m), base)| absorb(part, m, base, pass))
+        .collect();
+    Ok((tets, secs))
+}
+
+/// Builds one part's front from its inbox (owned faces first, then the
+/// context) and advances it in pass mode under its region filter.
+fn front_call(
+    inbox: Vec<(u32, FaceMsg)>,
+    k: u32,
+    loc: &Locator,
+    walls: &Interfaces,
+    part_of: &[u32],
+    size: &(dyn Fn(P3) -> f64 + Sync),
+) -> Result<Made, (usize, FrontError)> {
+    let t0 = Instant::now();
+    if !inbox.iter().any(|m| m.1.owned) {
+        return Ok(Made {
+            res: None,
+            input_gid: Vec::new(),
+            input_ok: Vec::new(),
+            seconds: 0.0,
+        });
+    }
+    let mut index: FxHashMap<u32, u32> = FxHashMap::default();
+    let mut pts = Vec::new();
+    let mut hs = Vec::new();
+    let mut gids = Vec::new();
+    let mut faces = Vec::with_capacity(inbox.len());
+    for owned in [true, false] {
+        for (_, m) in inbox.iter().filter(|m| m.1.owned == owned) {
+            faces.push(m.v.map(|r| {
+                *index.entry(r.gid).or_insert_with(|| {
+                    pts.push(r.p);
+                    hs.push(r.h);
+                    gids.push(r.gid);
+                    pts.len() as u32 - 1
+                })
+            }));
+        }
+    }
+    let filter = PartFilter {
+        loc,
+        walls,
+        part: part_of,
+        k,
+    };
+    let input_ok: Vec<bool> = pts
+        .iter()
+        .map(|&p| loc.owner(p, part_of) == Some(k))
+        .collect();
+    let res = advance(
+        FrontInput {
+            points: pts,
+            point_size: hs,
+            faces,
+        },
+        SizeMode::Field(size),
+        &filter,
+        &FrontOptions {
+            pass: true,
+            ..FrontOptions::default()
+        },
+    )
+    .map_err(|e| (k as usize, e))?;
+    let mut res = res;
+    let n_in = gids.len();
+    close_pockets(
+        &mut res,
+        |i| i as usize >= n_in || input_ok[i as usize],
+        size,
+    );
+    Ok(Made {
+        res: Some(res),
+        input_gid: gids,
+        input_ok,
+        seconds: t0.elapsed().as_secs_f64(),
+    })
+}
+
+/// Largest pocket (faces) a pass closes itself.
+const MAX_POCKET: usize = 4000;
+/// Recovery rounds a pocket gets (the serial front's default is 60).
+const POCKET_ROUNDS: u32 = 8;
+
+/// Recovery inside a pass (§7 needs it as much as the serial front does):
+/// the faces a pass could not advance without relaxing its acceptance are
+/// left behind, and many form small closed pockets inside the part's own
+/// region. Each such pocket (an edge-connected set of faces the part owns,
+/// closed on its own, facing in, small) is closed here by the front with
+/// recovery on: a closed front bounds what it fills, so no filter is
+/// needed. A pocket that stays stuck is left as it was for the next pass.
+/// Returns the tets made.
+fn close_pockets(
+    res: &mut parafront_front::FrontResult,
+    ok: impl Fn(u32) -> bool,
+    size: &(dyn Fn(P3) -> f64 + Sync),
+) -> usize {
+    let own: Vec<usize> = (0..res.front.len())
+        .filter(|&f| res.front[f].iter().all(|&i| ok(i)))
+        .collect();
+    if own.is_empty() {
+        return 0;
+    }
+    // Components through shared edges (union-find over faces).
+    let mut up: Vec<usize> = (0..own.len()).collect();
+    fn root(up: &mut [usize], mut x: usize) -> usize {
+        while up[x] != x {
+            up[x] = up[up[x]];
+            x = up[x];
+        }
+        x
+    }
+    let mut edges: Vec<(u32, u32, usize)> = Vec::with_capacity(own.len() * 3);
+    for (j, &f) in own.iter().enumerate() {
+        let v = res.front[f];
+        for c in 0..3 {
+            let (a, b) = (v[c], v[(c + 1) % 3]);
+            edges.push((a.min(b), a.max(b), j));
+        }
+    }
+    edges.sort_unstable();
+    for w in edges.windows(2) {
+        if (w[0].0, w[0].1) == (w[1].0, w[1].1) {
+            let (a, b) = (root(&mut up, w[0].2), root(&mut up, w[1].2));
+            if a != b {
+                up[a.max(b)] = a.min(b);
+            }
+        }
+    }
+    let mut comp: Vec<(usize, usize)> =
+        (0..own.len()).map(|j| (root(&mut up, j), own[j])).collect();
+    comp.sort_unstable();
+    let mut done = vec![false; res.front.len()];
+    let mut made = 0;
+    let mut i = 0;
+    while i < comp.len() {
+        let mut j = i;
+        while j < comp.len() && comp[j].0 == comp[i].0 {
+            j += 1;
+        }
+        let faces: Vec<[u32; 3]> = comp[i..j].iter().map(|c| res.front[c.1]).collect();
+        // Closed on its own: every directed edge as often as its reverse.
+        let mut e: Vec<(u32, u32)> = Vec::with_capacity(faces.len() * 3);
+        for v in &faces {
+            for c in 0..3 {
+                e.push((v[c], v[(c + 1) % 3]));
+            }
+        }
+        e.sort_unstable();
+        let closed = e.iter().all(|&(a, b)| {
+            let n = |x: (u32, u32)| e.partition_point(|y| *y <= x) - e.partition_point(|y| *y < x);
+            n((a, b)) == n((b, a))
+        });
+        // A large closed set is not a pocket (it may wrap another part's
+        // region); it waits for the next pass.
+        // A pocket is a small cavity: the faces point into it (negative
+        // signed volume), and it holds about a tet per face. A closed set
+        // facing out bounds the rest of the region, not a pocket.
+        let mut vol = 0.0;
+        let mut hsum = 0.0;
+        for f in &faces {
+            let [a, b, c] = f.map(|i| res.points[i as usize]);
+            vol += parafront_geom::dot(a, parafront_geom::cross(b, c)) / 6.0;
+            hsum += f.iter().map(|&i| res.point_size[i as usize]).sum::<f64>() / 3.0;
+        }
+        let hm = hsum / faces.len() as f64;
+        let pocket = vol < 0.0 && -vol <= faces.len() as f64 * hm * hm * hm;
+        if std::env::var_os("PARAFRONT_DEBUG_PASSES").is_some() && closed {
+            eprintln!(
+                "pocket: {} faces, vol {vol:.3e}, h {hm:.3e}, taken {}",
+                faces.len(),
+                pocket && faces.len() <= MAX_POCKET
+            );
+        }
+        if closed && pocket && faces.len() <= MAX_POCKET {
+            let mut pts: Vec<u32> = faces.iter().flatten().copied().collect();
+            pts.sort_unstable();
+            pts.dedup();
+            let local = |p: u32| pts.binary_search(&p).unwrap() as u32;
+            let r = advance(
+                FrontInput {
+                    points: pts.iter().map(|&p| res.points[p as usize]).collect(),
+                    point_size: pts.iter().map(|&p| res.point_size[p as usize]).collect(),
+                    faces: faces.iter().map(|f| f.map(local)).collect(),
+                },
+                SizeMode::Field(size),
+                &Everywhere,
+                &FrontOptions {
+                    recovery_rounds: POCKET_ROUNDS,
+                    max_points: 50 * faces.len() + pts.len(),
+                    ..FrontOptions::default()
+                },
+            );
+            if let Ok(r) = r {
+                if r.front.is_empty() {
+                    let base = res.points.len() as u32;
+                    let n = pts.len();
+                    res.points.extend_from_slice(&r.points[n..]);
+                    res.point_size.extend_from_slice(&r.point_size[n..]);
+                    let map = |q: u32| {
+                        if (q as usize) < n {
+                            pts[q as usize]
+                        } else {
+                            base + q - n as u32
+                        }
+                    };
+                    res.tets.extend(r.tets.iter().map(|t| t.map(map)));
+                    made += r.tets.len();
+                    for c in &comp[i..j] {
+                        done[c.1] = true;
+                    }
+                }
+            }
+        }
+        i = j;
+    }
+    let mut k = 0;
+    res.front.retain(|_| {
+        k += 1;
+        !done[k - 1]
+    });
+    made
+}
+
+/// Takes a front call's tets, new points (global ids from `base`) and the
+/// remaining faces it owns into the part's store. Context faces come back
+/// untouched and are dropped: their holder still has them.
+fn absorb(part: &mut Part, m: Made, base: u32, pass: u8) -> usize {
+    let Some(r) = m.res else { return 0 };
+    let n_in = m.input_gid.len();
+    let map: Vec<u32> = (0..r.points.len())
+        .map(|i| {
+            let gid = if i < n_in {
+                m.input_gid[i]
+            } else {
+                base + (i - n_in) as u32
+            };
+            part.local(Rec {
+                gid,
+                p: r.points[i],
+                h: r.point_size[i],
+            })
+        })
+        .collect();
+    let ok = |i: u32| (i as usize) >= n_in || m.input_ok[i as usize];
+    for f in &r.front {
+        if f.iter().all(|&i| ok(i)) {
+            part.front.push(f.map(|i| map[i as usize]));
+        }
+    }
+    for t in &r.tets {
+        part.tets.push(t.map(|i| map[i as usize]));
+        part.tet_pass.push(pass);
+    }
+    r.tets.len()
+}
+
+/// Layers peeled around the front before pass 4 gives up.
+const MAX_PEEL: usize = 4;
+
+/// Pass 4: every part sends what is left of its front to part 0, which
+/// closes it with the serial front (recovery on). What passes 1 to 3 left
+/// are faces the front could not advance without recovery, and recovery
+/// can only remove tets of its own call: so the parts first remove the
+/// tets touching the left-over front (one layer, one more per try when the
+/// serial front still gets stuck) and send their faces along.
+/// Returns the tets made and the tets removed.
+fn serial_pass<C: Comm>(
+    parts: &mut [Part],
+    comm: &C,
+    size: &(dyn Fn(P3) -> f64 + Sync),
+    next_gid: &mut u32,
+) -> Result<(usize, usize), PassError> {
+    let out: Vec<Vec<(u32, [Rec; 3])>> = parts
+        .iter_mut()
+        .map(|p| {
+            let faces = std::mem::take(&mut p.front);
+            faces.iter().map(|f| (0u32, f.map(|i| p.rec(i)))).collect()
+        })
+        .collect();
+    let mut hole: Vec<[Rec; 3]> = comm
+        .exchange(out)
+        .swap_remove(0)
+        .into_iter()
+        .map(|m| m.1)
+        .collect();
+    if hole.is_empty() {
+        return Ok((0, 0));
+    }
+    let mut removed = 0;
+    // The front left over is what the passes could not advance: a first
+    // try without room spends long in recovery, so peel from the start.
+    let mut peel = 1;
+    loop {
+        removed += peel_layer(parts, comm, &mut hole);
+        let mut index: FxHashMap<u32, u32> = FxHashMap::default();
+        let (mut pts, mut hs, mut gids) = (Vec::new(), Vec::new(), Vec::new());
+        let faces: Vec<[u32; 3]> = hole
+            .iter()
+            .map(|v| {
+                v.map(|r| {
+                    *index.entry(r.gid).or_insert_with(|| {
+                        pts.push(r.p);
+                        hs.push(r.h);
+                        gids.push(r.gid);
+                        pts.len() as u32 - 1
+                    })
+                })
+            })
+            .collect();
+        let t0 = Instant::now();
+        let res = advance(
+            FrontInput {
+                points: pts,
+                point_size: hs,
+                faces,
+            },
+            SizeMode::Field(size),
+            &Everywhere,
+            &FrontOptions {
+                // Bounded: peeling a layer is the better next step.
+                recovery_rounds: if peel < MAX_PEEL { 12 } else { 60 },
+                ..FrontOptions::default()
+            },
+        );
+        let res = match res {
+            Ok(r) => r,
+            Err(FrontError::Stuck { .. }) if peel < MAX_PEEL => {
+                peel += 1;
+                continue;
+            }
+            Err(source) => {
+                return Err(PassError::Pass {
+                    pass: 4,
+                    part: 0,
+                    source,
+                })
+            }
+        };
+        let n_new = (res.points.len() - gids.len()) as u32;
+        let m = Made {
+            input_ok: vec![true; gids.len()],
+            input_gid: gids,
+            res: Some(res),
+            seconds: t0.elapsed().as_secs_f64(),
+        };
+        let n = absorb(&mut parts[0], m, *next_gid, 4);
+        *next_gid += n_new;
+        return Ok((n, removed));
+    }
+}
+
+/// Removes, in every part, the tets that touch a point of `hole` (the
+/// point ids go out by all-gather) and adds their faces to `hole` (sent to
+/// part 0), cancelling the faces that now have the hole on both sides.
+/// Returns the tets removed.
+fn peel_layer<C: Comm>(parts: &mut [Part], comm: &C, hole: &mut Vec<[Rec; 3]>) -> usize {
+    let mut marked: Vec<u32> = hole.iter().flatten().map(|r| r.gid).collect();
+    marked.sort_unstable();
+    marked.dedup();
+    // Part 0 holds the hole; every part gets its points.
+    let marked = comm.all_gather(vec![marked; parts.len()]).swap_remove(0);
+    let marked: rustc_hash::FxHashSet<u32> = marked.into_iter().collect();
+    // Faces of a positive tet, oriented into the tet (into the hole).
+    const INWARD: [[usize; 3]; 4] = [[1, 3, 2], [0, 2, 3], [0, 3, 1], [0, 1, 2]];
+    let out: Vec<Vec<(u32, [Rec; 3])>> = parts
+        .par_iter_mut()
+        .map(|part| {
+            let mut out = Vec::new();
+            let mut keep_t = Vec::with_capacity(part.tets.len());
+            let mut keep_p = Vec::with_capacity(part.tets.len());
+            for (t, tv) in part.tets.iter().enumerate() {
+                if tv.iter().any(|&i| marked.contains(&part.gid[i as usize])) {
+                    for f in INWARD {
+                        out.push((0u32, f.map(|c| part.rec(tv[c]))));
+                    }
+                } else {
+                    keep_t.push(*tv);
+                    keep_p.push(part.tet_pass[t]);
+                }
+            }
+            part.tets = keep_t;
+            part.tet_pass = keep_p;
+            out
+        })
+        .collect();
+    let inbox = comm.exchange(out).swap_remove(0);
+    let removed = inbox.len() / 4;
+    hole.extend(inbox.into_iter().map(|m| m.1));
+    // Cancel opposite pairs: sort by the unordered triple, then match the
+    // two orientations one for one.
+    let canon = |v: &[Rec; 3]| {
+        let g = v.map(|r| r.gid);
+        let r = (0..3).min_by_key(|&k| g[k]).unwrap();
+        let (a, b, c) = (g[r], g[(r + 1) % 3], g[(r + 2) % 3]);
+        if b < c {
+            ((a, b, c), true)
+        } else {
+            ((a, c, b), false)
+        }
+    };
+    let mut order: Vec<(u32, u32, u32, bool, usize)> = hole
+        .iter()
+        .enumerate()
+        .map(|(i, v)| {
+            let (k, o) = canon(v);
+            (k.0, k.1, k.2, o, i)
+        })
+        .collect();
+    order.sort_unstable();
+    let mut drop = vec![false; hole.len()];
+    let mut i = 0;
+    while i < order.len() {
+        let mut j = i;
+        while j < order.len()
+            && (order[j].0, order[j].1, order[j].2) == (order[i].0, order[i].1, order[i].2)
+        {
+            j += 1;
+        }
+        let pos: Vec<usize> = order[i..j].iter().filter(|x| x.3).map(|x| x.4).collect();
+        let neg: Vec<usize> = order[i..j].iter().filter(|x| !x.3).map(|x| x.4).collect();
+        for (a, b) in pos.iter().zip(&neg) {
+            drop[*a] = true;
+            drop[*b] = true;
+        }
+        i = j;
+    }
+    let mut k = 0;
+    hole.retain(|_| {
+        k += 1;
+        !drop[k - 1]
+    });
+    removed
+}

@@ -1,0 +1,226 @@
+//! Redistribution (paper §8, step 4): each tet goes to the lowest part its
+//! points' DDG hosts give, doubly defined points are merged by exact
+//! coordinate keys, points and tets get global numbers, and each part
+//! learns its neighbours and the points it shares with each (bounding-box
+//! overlap first, then an exact match).
+use crate::{ParOutput, Part, PassError};
+use parafront_comm::Comm;
+use parafront_ddg::Locator;
+use parafront_geom::{Aabb, P3};
+use rayon::prelude::*;
+use rustc_hash::FxHashMap;
+
+/// One part of the partitioned mesh.
+#[derive(Clone, Debug, Default)]
+pub struct Piece {
+    pub points: Vec<P3>,
+    /// Global point id (the merged mesh's numbering).
+    pub gid: Vec<u32>,
+    /// The part that owns each point: the lowest part holding it. Points
+    /// owned elsewhere are this part's ghosts.
+    pub owner: Vec<u32>,
+    /// Local point ids.
+    pub tets: Vec<[u32; 4]>,
+    pub tet_gid: Vec<u32>,
+    pub tet_pass: Vec<u8>,
+    /// Parts sharing points with this one, ascending.
+    pub neighbours: Vec<u32>,
+    /// Per neighbour, the local ids of the shared points in ascending
+    /// global id: the send/receive list.
+    pub shared: Vec<Vec<u32>>,
+}
+
+type Key = [u64; 3];
+
+fn key(p: P3) -> Key {
+    // -0.0 and 0.0 are one point.
+    p.map(|x| (x + 0.0).to_bits())
+}
+
+struct TetMsg {
+    v: [(u32, P3); 4],
+    pass: u8,
+}
+
+pub(crate) fn run<C: Comm>(
+    parts: Vec<Part>,
+    comm: &C,
+    loc: &Locator,
+    part0: &[u32],
+    input: &[P3],
+    n_gid: u32,
+) -> Result<ParOutput, PassError> {
+    let np = parts.len();
+    // Each tet to the lowest part among its points' DDG hosts.
+    let out: Vec<Vec<(u32, TetMsg)>> = parts
+        .into_par_iter()
+        .enumerate()
+        .map(|(k, part)| {
+            let mut host: Vec<Option<u32>> = vec![None; part.pts.len()];
+            let mut out = Vec::with_capacity(part.tets.len());
+            for (t, tv) in part.tets.iter().enumerate() {
+                let dst = tv
+                    .iter()
+                    .map(|&i| {
+                        *host[i as usize].get_or_insert_with(|| {
+                            loc.lowest_host(part.pts[i as usize], part0)
+                                .unwrap_or(k as u32)
+                        })
+                    })
+                    .min()
+                    .unwrap();
+                let v = tv.map(|i| (part.gid[i as usize], part.pts[i as usize]));
+                out.push((
+                    dst,
+                    TetMsg {
+                        v,
+                        pass: part.tet_pass[t],
+                    },
+                ));
+            }
+            out
+        })
+        .collect();
+    let inbox = comm.exchange(out);
+
+    // Each part: its points once, by exact key.
+    let mut pieces: Vec<(Piece, FxHashMap<Key, u32>)> = inbox
+        .into_par_iter()
+        .map(|msgs| {
+            let mut pc = Piece::default();
+            let mut map: FxHashMap<Key, u32> = FxHashMap::default();
+            for (_, m) in &msgs {
+                let mut tv = [0u32; 4];
+                for (c, &(g, p)) in m.v.iter().enumerate() {
+                    let i = *map.entry(key(p)).or_insert_with(|| {
+                        pc.points.push(p);
+                        pc.gid.push(g);
+                        pc.points.len() as u32 - 1
+                    });
+                    if pc.gid[i as usize] != g {
+                        return Err(PassError::Redistribute(format!(
+                            "points {} and {g} are both at {p:?}",
+                            pc.gid[i as usize]
+                        )));
+                    }
+                    tv[c] = i;
+                }
+                pc.tets.push(tv);
+                pc.tet_pass.push(m.pass);
+            }
+            Ok((pc, map))
+        })
+        .collect::<Result<_, PassError>>()?;
+
+    // Global tet numbers: by part, then local order.
+    let counts = comm.all_gather(pieces.iter().map(|p| p.0.tets.len() as u32).collect());
+    let mut base = 0u32;
+    for (k, (pc, _)) in pieces.iter_mut().enumerate() {
+        pc.tet_gid = (base..base + counts[k]).collect();
+        base += counts[k];
+    }
+
+    // Send/receive lists: box overlap, then exact keys.
+    let boxes = comm.all_gather(
+        pieces
+            .iter()
+            .map(|p| Aabb::from_points(p.0.points.iter()))
+            .collect(),
+    );
+    let out: Vec<Vec<(u32, Vec<Key>)>> = pieces
+        .par_iter()
+        .enumerate()
+        .map(|(k, (pc, _))| {
+            let mut out = Vec::new();
+            for (q, b) in boxes.iter().enumerate() {
+                if q == k || b.is_empty() || !b.overlaps(&boxes[k]) {
+                    continue;
+                }
+                let keys: Vec<Key> = pc
+                    .points
+                    .iter()
+                    .filter(|&&p| b.contains(p))
+                    .map(|&p| key(p))
+                    .collect();
+                if !keys.is_empty() {
+                    out.push((q as u32, keys));
+                }
+            }
+            out
+        })
+        .collect();
+    let inbox = comm.exchange(out);
+    pieces
+        .par_iter_mut()
+        .zip(inbox)
+        .enumerate()
+        .for_each(|(k, ((pc, map), msgs))| {
+            pc.owner = vec![k as u32; pc.points.len()];
+            for (q, keys) in msgs {
+                let mut sh: Vec<u32> = keys.iter().filter_map(|x| map.get(x).copied()).collect();
+                if sh.is_empty() {
+                    continue;
+                }
+                sh.sort_unstable_by_key(|&i| pc.gid[i as usize]);
+                for &i in &sh {
+                    pc.owner[i as usize] = pc.owner[i as usize].min(q);
+                }
+                pc.neighbours.push(q);
+                pc.shared.push(sh);
+            }
+        });
+    let pieces: Vec<Piece> = pieces.into_iter().map(|p| p.0).collect();
+
+    // Global point numbers: the ids still in use, densely (tets removed
+    // for pass 4 may have left points behind), input points first.
+    let mut used = vec![false; n_gid as usize];
+    used[..input.len()].fill(true);
+    for ids in comm.all_gather(pieces.iter().map(|p| p.gid.clone()).collect()) {
+        for g in ids {
+            used[g as usize] = true;
+        }
+    }
+    let mut renum = vec![u32::MAX; n_gid as usize];
+    let mut n = 0u32;
+    for (g, &u) in used.iter().enumerate() {
+        if u {
+            renum[g] = n;
+            n += 1;
+        }
+    }
+    let mut pieces = pieces;
+    for pc in &mut pieces {
+        for g in &mut pc.gid {
+            *g = renum[*g as usize];
+        }
+    }
+
+    // The merged mesh (what part 0 would gather for a single-file output).
+    let mut points = vec![[f64::NAN; 3]; n as usize];
+    points[..input.len()].copy_from_slice(input);
+    let mut seen = vec![false; n as usize];
+    seen[..input.len()].fill(true);
+    let mut tets = Vec::new();
+    let mut tet_pass = Vec::new();
+    for pc in &pieces {
+        for (i, &g) in pc.gid.iter().enumerate() {
+            points[g as usize] = pc.points[i];
+            seen[g as usize] = true;
+        }
+        tets.extend(pc.tets.iter().map(|t| t.map(|i| pc.gid[i as usize])));
+        tet_pass.extend_from_slice(&pc.tet_pass);
+    }
+    if let Some(g) = seen.iter().position(|&s| !s) {
+        return Err(PassError::Redistribute(format!(
+            "point {g} is in no tet of any part"
+        )));
+    }
+    let _ = np;
+    Ok(ParOutput {
+        points,
+        tets,
+        tet_pass,
+        pieces,
+        stats: Default::default(),
+    })
+}

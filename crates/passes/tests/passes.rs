@@ -1,0 +1,148 @@
+use parafront_comm::Threads;
+use parafront_front::{advance, Everywhere, FrontInput, FrontOptions, SizeMode};
+use parafront_geom::{tet_volume6, P3};
+use parafront_mesh::{PointId, TetMesh};
+use parafront_passes::{mesh_parallel, ParOptions, ParOutput};
+use parafront_surface::{generate, Surface};
+
+fn run(s: &Surface, h: f64, parts: usize) -> ParOutput {
+    let field = move |_p: P3| h;
+    let faces: Vec<[u32; 3]> = s.tris.iter().map(|t| [t[0], t[2], t[1]]).collect();
+    let hs: Vec<f64> = s.mean_edge_lengths();
+    mesh_parallel(
+        &s.points,
+        &hs,
+        &faces,
+        &field,
+        &ParOptions {
+            parts,
+            ..ParOptions::default()
+        },
+        &Threads::new(parts),
+    )
+    .unwrap_or_else(|e| panic!("{parts} parts: {e}"))
+}
+
+fn serial_tets(s: &Surface, h: f64) -> usize {
+    let field = move |_p: P3| h;
+    let faces: Vec<[u32; 3]> = s.tris.iter().map(|t| [t[0], t[2], t[1]]).collect();
+    advance(
+        FrontInput {
+            points: s.points.clone(),
+            point_size: s.mean_edge_lengths(),
+            faces,
+        },
+        SizeMode::Field(&field),
+        &Everywhere,
+        &FrontOptions::default(),
+    )
+    .unwrap()
+    .tets
+    .len()
+}
+
+/// The merged mesh passes the exact check against the surface, and every
+/// tet is positive in floating point too.
+fn check(s: &Surface, o: &ParOutput) {
+    let mut m = TetMesh {
+        points: o.points.clone(),
+        tets: o.tets.iter().map(|t| t.map(PointId)).collect(),
+        region: vec![0; o.tets.len()],
+        ..Default::default()
+    };
+    m.build_adjacency().unwrap();
+    m.check_against_surface(&s.tris)
+        .unwrap_or_else(|e| panic!("invalid merged mesh: {e}"));
+    for t in &o.tets {
+        let p = t.map(|i| o.points[i as usize]);
+        assert!(tet_volume6(p[0], p[1], p[2], p[3]) > 0.0);
+    }
+    assert_eq!(o.stats.pass_tets.iter().sum::<usize>(), o.tets.len());
+    let in_pieces: usize = o.pieces.iter().map(|p| p.tets.len()).sum();
+    assert_eq!(in_pieces, o.tets.len());
+}
+
+#[test]
+fn a_sphere_on_2_4_8_parts() {
+    let s = generate::icosphere([0.0; 3], 1.0, 3);
+    let h = 0.12;
+    let n1 = serial_tets(&s, h);
+    for parts in [2, 4, 8] {
+        let o = run(&s, h, parts);
+        check(&s, &o);
+        let st = &o.stats;
+        eprintln!(
+            "P={parts}: tets {} (serial {n1}) per pass {:?}, ddg {} tets, imbalance {:.3}/{:.3}",
+            o.tets.len(),
+            st.pass_tets,
+            st.ddg_tets,
+            st.predicted_imbalance,
+            st.held_imbalance
+        );
+        let dev = (o.tets.len() as f64 / n1 as f64 - 1.0).abs();
+        assert!(
+            dev < 0.08,
+            "{parts} parts: {} tets, serial {n1}",
+            o.tets.len()
+        );
+        assert!(st.pass_tets[0] > st.pass_tets[3]);
+        assert!(
+            st.predicted_imbalance < 1.1,
+            "predicted imbalance {}",
+            st.predicted_imbalance
+        );
+        if parts == 2 {
+            // A smooth sphere in two halves: pass 4 is a small remainder
+            // (peeled tets included; the 1 % is not reached yet on
+            // a mesh this small, see the report).
+            let share = st.pass_tets[3] as f64 / o.tets.len() as f64;
+            assert!(share < 0.10, "pass 4 made {:.1}%", 100.0 * share);
+        }
+        // Every part holds tets, and the send/receive lists are symmetric.
+        for (k, pc) in o.pieces.iter().enumerate() {
+            assert!(!pc.tets.is_empty(), "part {k} holds no tets");
+            for (n, &q) in pc.neighbours.iter().enumerate() {
+                let other = &o.pieces[q as usize];
+                let back = other
+                    .neighbours
+                    .iter()
+                    .position(|&x| x == k as u32)
+                    .expect("symmetric neighbours");
+                let a: Vec<u32> = pc.shared[n].iter().map(|&i| pc.gid[i as usize]).collect();
+                let b: Vec<u32> = other.shared[back]
+                    .iter()
+                    .map(|&i| other.gid[i as usize])
+                    .collect();
+                assert_eq!(a, b, "parts {k} and {q} disagree on their shared points");
+            }
+        }
+    }
+}
+
+#[test]
+fn the_mesh_does_not_depend_on_the_threads() {
+    let s = generate::torus([0.0; 3], 1.0, 0.4, 48, 20);
+    let h = 0.1;
+    let one = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap();
+    let two = rayon::ThreadPoolBuilder::new()
+        .num_threads(2)
+        .build()
+        .unwrap();
+    let a = one.install(|| run(&s, h, 4));
+    let b = two.install(|| run(&s, h, 4));
+    check(&s, &a);
+    assert_eq!(a.tets, b.tets);
+    assert_eq!(
+        a.points
+            .iter()
+            .map(|p| p.map(f64::to_bits))
+            .collect::<Vec<_>>(),
+        b.points
+            .iter()
+            .map(|p| p.map(f64::to_bits))
+            .collect::<Vec<_>>()
+    );
+}

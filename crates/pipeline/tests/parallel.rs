@@ -1,0 +1,45 @@
+//! `parts > 1`: the parallel mesher through the pipeline, on a part with
+//! several regions (a void and an embedded body) and on a torus.
+use parafront_mesh::TetId;
+use parafront_pipeline::{mesh_surface, MeshOptions};
+use parafront_surface::generate;
+
+fn opts(parts: usize, h: f64) -> MeshOptions {
+    let mut o = MeshOptions {
+        parts,
+        ..MeshOptions::default()
+    };
+    o.size.h = Some(h);
+    o
+}
+
+#[test]
+fn the_demo_part_on_2_and_4_parts() {
+    let s = generate::demo_part();
+    let (m1, _) = mesh_surface(&s, &opts(1, 1.2)).unwrap();
+    for parts in [2, 4] {
+        let (m, sum) =
+            mesh_surface(&s, &opts(parts, 1.2)).unwrap_or_else(|e| panic!("{parts} parts: {e}"));
+        // mesh_surface checked it; check again here, independently of the flag.
+        m.check_against_surface(&s.tris).unwrap();
+        for t in 0..m.tets.len() {
+            let p = m.tet_points(TetId::new(t));
+            assert!(parafront_geom::tet_volume6(p[0], p[1], p[2], p[3]) > 0.0);
+        }
+        assert_eq!(sum.parallel.len(), sum.regions);
+        let made: usize = sum
+            .parallel
+            .iter()
+            .map(|p| p.pass_tets.iter().sum::<usize>())
+            .sum();
+        assert_eq!(made, m.tets.len());
+        assert_eq!(sum.pieces.len(), parts * sum.regions);
+        let dev = (m.tets.len() as f64 / m1.tets.len() as f64 - 1.0).abs();
+        assert!(
+            dev < 0.10,
+            "{parts} parts: {} tets, serial {}",
+            m.tets.len(),
+            m1.tets.len()
+        );
+    }
+}
