@@ -252,3 +252,61 @@ fn optimize_flag_and_quality_before() {
     };
     assert!(share(&imp) < share(&raw), "{text}");
 }
+
+/// `--parts 2 --pvtu`: the merged mesh passes meshcheck, and the pieces
+/// hold every tet of it once. With improvement on, `--pvtu` is refused
+/// up front (its pieces number the mesh before improvement).
+#[test]
+fn parts_write_a_partitioned_mesh() {
+    let vol = tmp("demo_parts.vtu");
+    let pv = tmp("demo_parts.pvtu");
+    let o = bin()
+        .args(["demo", "--parts", "2", "--pvtu"])
+        .arg(&pv)
+        .arg("-o")
+        .arg(&vol)
+        .output()
+        .unwrap();
+    assert_eq!(
+        o.status.code(),
+        Some(2),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(String::from_utf8_lossy(&o.stderr).contains("--optimize 0"));
+    assert!(!vol.exists() && !pv.exists());
+    let o = bin()
+        .args(["demo", "--parts", "2", "--optimize", "0", "--pvtu"])
+        .arg(&pv)
+        .arg("-o")
+        .arg(&vol)
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        o.status.success(),
+        "{text}{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let m = parafront_io::read_mesh(&vol).unwrap();
+    m.check_against_surface(&parafront_surface::generate::demo_part().tris)
+        .unwrap();
+    let surf = tmp("demo_parts_surface.vtu");
+    assert!(bin()
+        .args(["demo", "--check-only", "-o"])
+        .arg(&surf)
+        .output()
+        .unwrap()
+        .status
+        .success());
+    meshcheck(&vol, &surf);
+    // Every piece file is there, and together they hold each tet once.
+    let pvtu = std::fs::read_to_string(&pv).unwrap();
+    let mut total = 0;
+    for src in pvtu.split("Source=\"").skip(1) {
+        let name = src.split('"').next().unwrap();
+        let piece = parafront_io::read_mesh(&pv.parent().unwrap().join(name)).unwrap();
+        total += piece.tets.len();
+    }
+    assert_eq!(total, m.tets.len(), "{pvtu}");
+}
