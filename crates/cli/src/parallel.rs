@@ -149,9 +149,11 @@ pub fn run_bench(
                 .num_threads(t.max(1))
                 .build()
                 .map_err(|e| Fail(2, e.to_string()))?;
+            // Generation only, as in the paper's tables: no improvement.
             let mut o = parafront_pipeline::MeshOptions {
                 parts: p.max(1),
                 threads: t,
+                optimize: 0,
                 ..Default::default()
             };
             o.size.h = size;
