@@ -5,8 +5,10 @@ use parafront_pipeline::{mesh_surface, MeshOptions};
 use parafront_surface::generate;
 
 fn opts(parts: usize, h: f64) -> MeshOptions {
+    // Generation only: improvement changes the mesh after the passes.
     let mut o = MeshOptions {
         parts,
+        optimize: 0,
         ..MeshOptions::default()
     };
     o.size.h = Some(h);
