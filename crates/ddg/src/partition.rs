@@ -136,6 +136,7 @@ mod tests {
             s.mean_edge_lengths(),
             faces,
             crate::DEFAULT_GROWTH,
+            crate::DdgMode::default(),
         )
         .unwrap()
     }

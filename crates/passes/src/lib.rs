@@ -195,6 +195,7 @@ pub fn mesh_parallel<C: Comm>(
         point_size.to_vec(),
         faces.to_vec(),
         opts.growth,
+        ddg::DdgMode::default(),
     )
     .map_err(PassError::Ddg)?;
     st.ddg_tets = d.tets.len();
