@@ -163,6 +163,8 @@ struct Front<'a> {
     talive: Vec<bool>,
     stuck: Vec<u32>,
     prohibited: Vec<u32>,
+    /// Per point: 0 not asked yet, 1 inside the region, 2 outside.
+    point_in: Vec<u8>,
     relax: u32,
     opts: &'a FrontOptions,
     region: &'a dyn RegionFilter,
@@ -399,6 +401,7 @@ pub fn advance(
         talive: Vec::new(),
         stuck: Vec::new(),
         prohibited: Vec::new(),
+        point_in: Vec::new(),
         relax: 0,
         opts,
         region,
@@ -718,11 +721,28 @@ impl<'a> Front<'a> {
         }
     }
 
+    /// The region filter on point `i`, asked once per point: points do not
+    /// move, and a pass's filter is a point location in the DDG.
+    fn point_in(&mut self, i: u32) -> bool {
+        let i = i as usize;
+        if i >= self.point_in.len() {
+            self.point_in.resize(self.pts.len().max(i + 1), 0);
+        }
+        if self.point_in[i] == 0 {
+            self.point_in[i] = if self.region.point_ok(self.pts[i]) {
+                1
+            } else {
+                2
+            };
+        }
+        self.point_in[i] == 1
+    }
+
     fn try_face(&mut self, fid: u32) -> Outcome {
         let v = self.fv[fid as usize];
         let [pa, pb, pc] = v.map(|i| self.pts[i as usize]);
         // §7: a face with a point or an edge outside the region is skipped.
-        if !(self.region.point_ok(pa) && self.region.point_ok(pb) && self.region.point_ok(pc)) {
+        if !(self.point_in(v[0]) && self.point_in(v[1]) && self.point_in(v[2])) {
             return Outcome::Prohibited;
         }
         if !(self.region.edge_ok(pa, pb)
@@ -783,7 +803,7 @@ impl<'a> Front<'a> {
             if dist2(pq, pstar) < too_close * too_close {
                 star_clear = false;
             }
-            if !self.region.point_ok(pq) {
+            if !self.point_in(q) {
                 continue; // §7: a close point outside the region is dropped
             }
             // A mean ratio over the floor is a volume far above rounding:
