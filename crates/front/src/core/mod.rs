@@ -556,10 +556,10 @@ impl<'a> Front<'a> {
             if self.stuck.is_empty() {
                 return Ok(());
             }
-            if self.opts.pass {
-                // §7: what a pass cannot close goes to the next pass. A
-                // removal round here was tried: it cost 15-20 % of the run
-                // and left pass 4 as many faces.
+            if self.opts.pass && self.relax >= 1 {
+                // §7: what a pass cannot close goes to the next pass, after
+                // one round of removal and re-meshing, so that it hands over
+                // no worse a front than it could make.
                 self.prohibited.append(&mut self.stuck);
                 return Ok(());
             }
