@@ -176,6 +176,19 @@ fn check_corpus_exit_codes() {
 /// The README's first command, end to end: the demo part (a hole, a void
 /// and an embedded body) is meshed, and meshcheck agrees that the mesh keeps
 /// the surface and fills it exactly.
+/// `meshcheck.py` on a volume mesh of the demo part, against the surface
+/// `demo --check-only` writes.
+fn meshcheck_demo(vol: &Path) {
+    let surf = vol.with_extension("surface.vtu");
+    let o = bin()
+        .args(["demo", "--check-only", "-o"])
+        .arg(&surf)
+        .output()
+        .unwrap();
+    assert!(o.status.success());
+    meshcheck(vol, &surf);
+}
+
 #[test]
 fn demo_mesh_passes_meshcheck() {
     let vol = tmp("demo_volume.vtu");
@@ -197,14 +210,7 @@ fn demo_mesh_passes_meshcheck() {
     let tris: Vec<[u32; 3]> = s.tris.clone();
     m.check_against_surface(&tris).unwrap();
 
-    let surf = tmp("demo_surface_for_check.vtu");
-    let o = bin()
-        .args(["demo", "--check-only", "-o"])
-        .arg(&surf)
-        .output()
-        .unwrap();
-    assert!(o.status.success());
-    meshcheck(&vol, &surf);
+    meshcheck_demo(&vol);
 }
 
 /// `--optimize 0` switches improvement off; the default reports before and
@@ -291,15 +297,7 @@ fn parts_write_a_partitioned_mesh() {
     let m = parafront_io::read_mesh(&vol).unwrap();
     m.check_against_surface(&parafront_surface::generate::demo_part().tris)
         .unwrap();
-    let surf = tmp("demo_parts_surface.vtu");
-    assert!(bin()
-        .args(["demo", "--check-only", "-o"])
-        .arg(&surf)
-        .output()
-        .unwrap()
-        .status
-        .success());
-    meshcheck(&vol, &surf);
+    meshcheck_demo(&vol);
     // Every piece file is there, and together they hold each tet once.
     let pvtu = std::fs::read_to_string(&pv).unwrap();
     let mut total = 0;
