@@ -151,53 +151,10 @@ pub fn mesh_surface(s: &Surface, opts: &MeshOptions) -> Result<(TetMesh, Summary
         bnd_patch: s.patch.clone(),
         ..Default::default()
     };
-    let field = |p| sizing.size(p);
     if opts.parts > 1 {
         mesh_parts(s, &fronts, &sizing, opts, &mut mesh, &mut sum)?;
-    }
-    for (r, rf) in fronts.iter().enumerate().filter(|_| opts.parts <= 1) {
-        let input = FrontInput {
-            points: rf.points.iter().map(|&i| s.points[i as usize]).collect(),
-            point_size: rf
-                .points
-                .iter()
-                .map(|&i| sizing.surface_point_sizes()[i as usize])
-                .collect(),
-            faces: rf.faces.clone(),
-        };
-        let n_in = rf.points.len();
-        let res = advance(
-            input,
-            SizeMode::Field(&field),
-            &parafront_front::Everywhere,
-            &FrontOptions {
-                progress: opts.progress.clone(),
-                keep_partial: opts.debug_partial,
-                ..FrontOptions::default()
-            },
-        )
-        .map_err(|e| MeshError::Front {
-            region: r,
-            source: e,
-        })?;
-        // Local ids: the region's surface points, then its new points.
-        let base = mesh.points.len() as u32;
-        let map = |p: u32| {
-            if (p as usize) < n_in {
-                rf.points[p as usize]
-            } else {
-                base + p - n_in as u32
-            }
-        };
-        mesh.points.extend_from_slice(&res.points[n_in..]);
-        mesh.tets
-            .extend(res.tets.iter().map(|t| t.map(|p| PointId(map(p)))));
-        mesh.region
-            .extend(std::iter::repeat_n(rf.region_id, res.tets.len()));
-        sum.recovery_rounds += res.stats.recovery_rounds;
-        sum.tets_removed += res.stats.tets_removed;
-    }
-    if opts.parts <= 1 {
+    } else {
+        mesh_serial(s, &fronts, &sizing, opts, &mut mesh, &mut sum)?;
         sum.stages.push(("front", t0.elapsed().as_secs_f64()));
     }
 
@@ -243,6 +200,88 @@ pub fn mesh_surface(s: &Surface, opts: &MeshOptions) -> Result<(TetMesh, Summary
     Ok((mesh, sum))
 }
 
+/// The serial front (§4) on each region, appended to `mesh`.
+fn mesh_serial(
+    s: &Surface,
+    fronts: &[RegionFront],
+    sizing: &Sizing,
+    opts: &MeshOptions,
+    mesh: &mut TetMesh,
+    sum: &mut Summary,
+) -> Result<(), MeshError> {
+    let field = |p| sizing.size(p);
+    for (r, rf) in fronts.iter().enumerate() {
+        let (points, point_size) = region_points(s, sizing, rf);
+        let input = FrontInput {
+            points,
+            point_size,
+            faces: rf.faces.clone(),
+        };
+        let res = advance(
+            input,
+            SizeMode::Field(&field),
+            &parafront_front::Everywhere,
+            &FrontOptions {
+                progress: opts.progress.clone(),
+                keep_partial: opts.debug_partial,
+                ..FrontOptions::default()
+            },
+        )
+        .map_err(|e| MeshError::Front {
+            region: r,
+            source: e,
+        })?;
+        append_region(mesh, rf, &res.points, &res.tets);
+        sum.recovery_rounds += res.stats.recovery_rounds;
+        sum.tets_removed += res.stats.tets_removed;
+    }
+    Ok(())
+}
+
+/// A region's surface points, in its local order, and their sizes (AG3).
+fn region_points(
+    s: &Surface,
+    sizing: &Sizing,
+    rf: &RegionFront,
+) -> (Vec<parafront_geom::P3>, Vec<f64>) {
+    let h = sizing.surface_point_sizes();
+    rf.points
+        .iter()
+        .map(|&i| (s.points[i as usize], h[i as usize]))
+        .unzip()
+}
+
+/// The mesh id of a region's local point `p`: its surface points come
+/// first (`rf.points`, in order), then its new points, which were appended
+/// to the mesh from `base` on.
+fn global_id(rf: &RegionFront, base: u32, p: u32) -> u32 {
+    let n_in = rf.points.len();
+    if (p as usize) < n_in {
+        rf.points[p as usize]
+    } else {
+        base + p - n_in as u32
+    }
+}
+
+/// Appends one region's points and tets (local ids) to `mesh`; returns the
+/// `base` of its new points for [`global_id`].
+fn append_region(
+    mesh: &mut TetMesh,
+    rf: &RegionFront,
+    points: &[parafront_geom::P3],
+    tets: &[[u32; 4]],
+) -> u32 {
+    let base = mesh.points.len() as u32;
+    mesh.points.extend_from_slice(&points[rf.points.len()..]);
+    mesh.tets.extend(
+        tets.iter()
+            .map(|t| t.map(|p| PointId(global_id(rf, base, p)))),
+    );
+    mesh.region
+        .extend(std::iter::repeat_n(rf.region_id, tets.len()));
+    base
+}
+
 /// The parallel mesher (§5 to §8) on each region, on the threads backend;
 /// the merged result goes into `mesh` like the serial front's.
 fn mesh_parts(
@@ -266,32 +305,14 @@ fn mesh_parts(
     let comm = parafront_comm::Threads::new(opts.parts);
     let mut stage = [0.0f64; 7];
     for (r, rf) in fronts.iter().enumerate() {
-        let pts: Vec<_> = rf.points.iter().map(|&i| s.points[i as usize]).collect();
-        let hs: Vec<f64> = rf
-            .points
-            .iter()
-            .map(|&i| sizing.surface_point_sizes()[i as usize])
-            .collect();
+        let (pts, hs) = region_points(s, sizing, rf);
         let out = mesh_parallel(&pts, &hs, &rf.faces, &field, &popts, &comm).map_err(|e| {
             MeshError::Parallel {
                 region: r,
                 source: e,
             }
         })?;
-        let n_in = rf.points.len();
-        let base = mesh.points.len() as u32;
-        let map = |p: u32| {
-            if (p as usize) < n_in {
-                rf.points[p as usize]
-            } else {
-                base + p - n_in as u32
-            }
-        };
-        mesh.points.extend_from_slice(&out.points[n_in..]);
-        mesh.tets
-            .extend(out.tets.iter().map(|t| t.map(|p| PointId(map(p)))));
-        mesh.region
-            .extend(std::iter::repeat_n(rf.region_id, out.tets.len()));
+        let base = append_region(mesh, rf, &out.points, &out.tets);
         let st = &out.stats;
         for (k, x) in [
             st.ddg_seconds,
@@ -309,7 +330,7 @@ fn mesh_parts(
         }
         for mut pc in out.pieces {
             for g in &mut pc.gid {
-                *g = map(*g);
+                *g = global_id(rf, base, *g);
             }
             sum.pieces.push(pc);
         }
