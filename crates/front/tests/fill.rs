@@ -202,3 +202,26 @@ fn a_failed_front_hands_back_its_partial_mesh() {
     got.sort_unstable();
     assert_eq!(got, expect);
 }
+
+/// Issue 3's quality target before any improvement: on a smooth surface,
+/// under 1 % of the tets have a dihedral angle under 10°. New points and
+/// new edges keep clear of the front, so fronts meeting leave no slabs.
+#[test]
+fn a_smooth_sphere_has_few_slivers_before_improvement() {
+    let s = generate::icosphere([0.0; 3], 1.0, 4);
+    let (m, _) = fill(&s, 0.1);
+    let bad = m
+        .tets
+        .iter()
+        .filter(|t| {
+            let p = t.map(|i| m.points[i.0 as usize]);
+            parafront_mesh::quality::dihedral_angles(p)
+                .iter()
+                .any(|&a| a < 10.0)
+        })
+        .count();
+    let share = bad as f64 / m.tets.len() as f64;
+    eprintln!("sphere: {} tets, {bad} under 10 deg", m.tets.len());
+    assert!(m.tets.len() > 10_000, "{} tets", m.tets.len());
+    assert!(share < 0.01, "{:.2} % of tets under 10 deg", 100.0 * share);
+}

@@ -114,6 +114,50 @@ pub fn point_triangle_dist2(p: P3, a: P3, b: P3, c: P3) -> f64 {
     dist2(p, add(a, add(scale(ab, v), scale(ac, w))))
 }
 
+/// Squared distance between segments `p0p1` and `q0q1` (closest points by
+/// clamped parameters, Ericson §5.1.9).
+pub fn segment_segment_dist2(p0: P3, p1: P3, q0: P3, q1: P3) -> f64 {
+    let d1 = sub(p1, p0);
+    let d2 = sub(q1, q0);
+    let r = sub(p0, q0);
+    let a = norm2(d1);
+    let e = norm2(d2);
+    let f = dot(d2, r);
+    let (s, t);
+    if a <= 1e-300 && e <= 1e-300 {
+        return norm2(r);
+    }
+    if a <= 1e-300 {
+        s = 0.0;
+        t = (f / e).clamp(0.0, 1.0);
+    } else {
+        let c = dot(d1, r);
+        if e <= 1e-300 {
+            t = 0.0;
+            s = (-c / a).clamp(0.0, 1.0);
+        } else {
+            let b = dot(d1, d2);
+            let denom = a * e - b * b;
+            let mut s0 = if denom > 0.0 {
+                ((b * f - c * e) / denom).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            let mut t0 = (b * s0 + f) / e;
+            if t0 < 0.0 {
+                t0 = 0.0;
+                s0 = (-c / a).clamp(0.0, 1.0);
+            } else if t0 > 1.0 {
+                t0 = 1.0;
+                s0 = ((b - c) / a).clamp(0.0, 1.0);
+            }
+            s = s0;
+            t = t0;
+        }
+    }
+    dist2(add(p0, scale(d1, s)), add(q0, scale(d2, t)))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -125,5 +169,36 @@ mod tests {
         assert_eq!(point_triangle_dist2([1.0, -2.0, 0.0], a, b, c), 4.0); // edge ab
         assert!((point_triangle_dist2([2.0, 2.0, 0.0], a, b, c) - 2.0).abs() < 1e-15); // edge bc
         assert_eq!(point_triangle_dist2([3.0, 0.0, 1.0], a, b, c), 2.0); // vertex b
+    }
+
+    #[test]
+    fn segment_distance_by_region() {
+        let o = [0.0, 0.0, 0.0];
+        let x = [2.0, 0.0, 0.0];
+        // Crossing at a height: interior to interior.
+        assert_eq!(
+            segment_segment_dist2(o, x, [1.0, -1.0, 0.5], [1.0, 1.0, 0.5]),
+            0.25
+        );
+        // Parallel and overlapping.
+        assert_eq!(
+            segment_segment_dist2(o, x, [1.0, 1.0, 0.0], [3.0, 1.0, 0.0]),
+            1.0
+        );
+        // End to end.
+        assert_eq!(
+            segment_segment_dist2(o, x, [3.0, 0.0, 0.0], [4.0, 1.0, 0.0]),
+            1.0
+        );
+        // End to interior.
+        assert_eq!(
+            segment_segment_dist2(o, x, [1.0, 2.0, 0.0], [1.0, 5.0, 0.0]),
+            4.0
+        );
+        // Degenerate segment.
+        assert_eq!(
+            segment_segment_dist2(o, x, [1.0, 0.0, 3.0], [1.0, 0.0, 3.0]),
+            9.0
+        );
     }
 }

@@ -193,6 +193,7 @@ impl<'a> Front<'a> {
             let cl = Clearance {
                 point: 0.02 * hmean,
                 wedge: 0.05,
+                new_point: 0.02 * hmean,
             };
             if self.apex_free(f, NONE, p, cl) {
                 take.push(f);

@@ -27,6 +27,10 @@ const STALL_ROUNDS: u32 = 8;
 const MAX_GROWTH_PER_TET: f64 = 2.0;
 
 const NONE: u32 = u32::MAX;
+/// How far a new point keeps from front faces, in sizes, by round.
+const NEW_POINT_CLEARANCE: [f64; 3] = [0.3, 0.2, 0.1];
+/// How far a new edge keeps from front edges, in point clearances.
+const EDGE_CLEARANCE: f64 = 2.0;
 
 /// Tuning of the front. The defaults are what the serial mesher uses.
 #[derive(Clone, Debug)]
@@ -231,6 +235,10 @@ fn shared_first(a: [u32; 3], ap: [P3; 3], b: [u32; 3], bp: [P3; 3]) -> ([P3; 3],
 struct Clearance {
     point: f64,
     wedge: f64,
+    /// A new point keeps this far from every front face: closer, it would
+    /// split a gap in two, one of them too thin for anything but slivers
+    /// (two fronts meeting across a plate); an existing point does better.
+    new_point: f64,
 }
 
 impl Clearance {
@@ -239,14 +247,17 @@ impl Clearance {
             0 => Clearance {
                 point: 0.05 * h,
                 wedge: 0.05,
+                new_point: NEW_POINT_CLEARANCE[0] * h,
             },
             1 | 2 => Clearance {
                 point: 0.03 * h,
                 wedge: 0.03,
+                new_point: NEW_POINT_CLEARANCE[1] * h,
             },
             _ => Clearance {
                 point: 0.015 * h,
                 wedge: 0.02,
+                new_point: NEW_POINT_CLEARANCE[2] * h,
             },
         }
     }
@@ -255,6 +266,7 @@ impl Clearance {
     const EXACT: Clearance = Clearance {
         point: 0.0,
         wedge: 0.0,
+        new_point: 0.0,
     };
 }
 
@@ -311,6 +323,16 @@ impl SeparatingPlanes {
             inv_len[i] = 1.0 / norm(v).max(1e-300);
         }
         SeparatingPlanes { o, n, nn, inv_len }
+    }
+
+    /// Some face plane has all of `g` more than `margin` outside it: `g`
+    /// keeps at least `margin` from the tet.
+    #[inline]
+    fn clear_of(&self, g: &[P3; 3], margin: f64) -> bool {
+        (0..4).any(|i| {
+            g.iter()
+                .all(|&x| dot(self.n[i], sub(x, self.o[i])) * self.inv_len[i] > margin)
+        })
     }
 
     /// `x` is inside the tet grown by `margin` on every face.
@@ -950,8 +972,15 @@ impl<'a> Front<'a> {
         }
         let new_faces: [[usize; 3]; 3] = [TET_FACES[0], TET_FACES[1], TET_FACES[2]];
         let planes = SeparatingPlanes::new(&tp);
+        let m_apex = if q >= NONE - 3 {
+            cl.new_point.max(margin)
+        } else {
+            margin
+        };
+        let em = EDGE_CLEARANCE * margin;
+        let tb_clear = tb.inflated(m_apex.max(em));
         for nf in near_f {
-            if !nf.bb.overlaps(&tb) {
+            if !nf.bb.overlaps(&tb_clear) {
                 continue;
             }
             let g = nf.v;
@@ -961,11 +990,31 @@ impl<'a> Front<'a> {
             // The apex keeps clear of front faces too, not only of front
             // points: a long face has its corners far away, and a tet that
             // hovers over its middle leaves a slab only slivers can fill.
-            if margin > 0.0
+            if m_apex > 0.0
                 && !g.contains(&q)
-                && point_triangle_dist2(pq, gp[0], gp[1], gp[2]) < margin * margin
+                && point_triangle_dist2(pq, gp[0], gp[1], gp[2]) < m_apex * m_apex
             {
                 return false;
+            }
+            // Nor may a new edge pass close by a front edge: two edges
+            // crossing a hair apart leave a slab between their faces that
+            // only slivers fill (thin plates of CAD needles).
+            if em > 0.0 && !planes.clear_of(&gp, em) {
+                for e in 0..3 {
+                    let a = tv[e];
+                    for k in 0..3 {
+                        let (g0, g1) = (g[k], g[(k + 1) % 3]);
+                        if g0 == a || g1 == a || g0 == q || g1 == q {
+                            continue;
+                        }
+                        if tv.contains(&g0) && tv.contains(&g1) {
+                            continue; // an edge of the tet itself
+                        }
+                        if segment_segment_dist2(tp[e], pq, gp[k], gp[(k + 1) % 3]) < em * em {
+                            return false;
+                        }
+                    }
+                }
             }
             for lf in &new_faces {
                 let fvid = lf.map(|k| tv[k]);
