@@ -473,9 +473,7 @@ impl<'a> Front<'a> {
         self.fowner.push(owner);
         self.ftries.push(0);
         self.fmap.insert(sorted3(v), id);
-        let bb = tri_box(&self.pts, v);
-        let ext = (0..3).map(|k| bb.max[k] - bb.min[k]).fold(0.0, f64::max);
-        self.fgrid.insert(id, bb.center(), ext);
+        self.fgrid.insert(id, &tri_box(&self.pts, v));
         let key = self.face_key(v);
         self.heap.push(heap_entry(key, id));
     }
@@ -486,7 +484,7 @@ impl<'a> Front<'a> {
         self.falive[i] = false;
         let v = self.fv[i];
         self.fmap.remove(&sorted3(v));
-        self.fgrid.remove(id);
+        self.fgrid.remove(id, &tri_box(&self.pts, v));
     }
 
     /// The front faces (all but `skip`) whose boxes meet `q`, and the
