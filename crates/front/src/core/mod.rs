@@ -277,11 +277,25 @@ fn thin_wedge(f: [u32; 3], fp: [P3; 3], g: [u32; 3], gp: [P3; 3], min: f64) -> b
     let u = perp(fp[i]);
     let w = perp(gp[j]);
     let n = normalize(tri_normal(fp[0], fp[1], fp[2]));
-    let psi = dot(w, n).atan2(dot(w, u));
+    let (y, x) = (dot(w, n), dot(w, u));
     // On the tet's side, a tiny angle means two near-coplanar faces whose
     // crossing the exact test may see as a miss by rounding (a flat quad
-    // cut by both diagonals).
-    psi.abs() < min
+    // cut by both diagonals). For x > 0 and min <= 0.1, |atan2(y, x)| < min
+    // iff |y|/x < tan(min), in [min, min (1 + min^2 / 2)]: atan2 (slow)
+    // decides only in between.
+    if x < 0.0 {
+        return false;
+    }
+    if x > 0.0 && min <= 0.1 {
+        let r = y.abs() / x;
+        if r < min * (1.0 - 1e-9) {
+            return true;
+        }
+        if r > min * (1.0 + 0.5 * min * min) * (1.0 + 1e-9) {
+            return false;
+        }
+    }
+    y.atan2(x).abs() < min
 }
 
 /// The four face planes of a tet, for a float filter ahead of the exact
@@ -352,6 +366,16 @@ impl SeparatingPlanes {
 #[inline]
 fn heap_entry(key: f64, face: u32) -> Reverse<u64> {
     Reverse(((key as f32).to_bits() as u64) << 32 | face as u64)
+}
+
+#[inline]
+fn box_dist2(b: &Aabb, p: P3) -> f64 {
+    let mut d2 = 0.0;
+    for k in 0..3 {
+        let d = (b.min[k] - p[k]).max(p[k] - b.max[k]).max(0.0);
+        d2 += d * d;
+    }
+    d2
 }
 
 fn median(h: &[f64]) -> f64 {
@@ -977,8 +1001,11 @@ impl<'a> Front<'a> {
             // The apex keeps clear of front faces too, not only of front
             // points: a long face has its corners far away, and a tet that
             // hovers over its middle leaves a slab only slivers can fill.
+            // The box is a cheap lower bound on the distance (kept with a
+            // slack so that rounding cannot decide differently).
             if margin > 0.0
                 && !g.contains(&q)
+                && box_dist2(&nf.bb, pq) < margin * margin * (1.0 + 1e-9)
                 && point_triangle_dist2(pq, gp[0], gp[1], gp[2]) < margin * margin
             {
                 return false;
