@@ -5,8 +5,8 @@
 //! coarse DDG interior), so one uniform grid is either too fine for the big
 //! faces or too coarse for the small ones. Level `k` has cells of size
 //! `s0 * 2^k`; an item of extent `e` lives at the level whose cell is at
-//! least `e`, keyed by the cell of its centre, so it stays within half a
-//! cell of that cell ("loose"). A cell holds its items' boxes, so a query
+//! least `2e`, keyed by the cell of its centre, so it stays within a
+//! quarter cell of that cell ("loose"). A cell holds its items' boxes, so a query
 //! returns only items whose box meets it. A query visits each non-empty level,
 //! either cell by cell or, when that would touch more cells than the level
 //! holds items, by scanning the level's items.
@@ -120,7 +120,10 @@ impl LooseGrid {
     fn place(&self, b: &Aabb) -> (usize, u64) {
         let ext = (0..3).map(|k| b.max[k] - b.min[k]).fold(0.0, f64::max);
         let mut k = 0;
-        while k + 1 < MAX_LEVELS && self.levels[k].cell < ext {
+        // Cells of at least twice the extent: a query's box (about twice a
+        // face) then spans 2-3 cells per axis. Equal cells took 15 % longer:
+        // each cell is a cache miss, a box test is not.
+        while k + 1 < MAX_LEVELS && self.levels[k].cell < 2.0 * ext {
             k += 1;
         }
         (k, cell_key(self.cell_of(b.center(), self.levels[k].cell)))
@@ -207,8 +210,8 @@ impl LooseGrid {
             let k = used.trailing_zeros() as usize;
             used &= used - 1;
             let lv = &self.levels[k];
-            // Items sit within half a cell of their cell.
-            let qq = q.inflated(0.5 * lv.cell);
+            // Items sit within a quarter cell of their cell.
+            let qq = q.inflated(0.25 * lv.cell);
             let lo = self.cell_of(qq.min, lv.cell);
             let hi = self.cell_of(qq.max, lv.cell);
             let ncell = (hi[0] - lo[0] + 1) as f64
