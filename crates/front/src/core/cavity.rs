@@ -187,7 +187,8 @@ impl<'a> Front<'a> {
         }
         let mut take = Vec::new();
         for &f in pocket {
-            if self.cone_shape(f, p) < 10.0 * CONE_FLOOR {
+            // A failed close_by_existing re-adds its faces under new ids.
+            if !self.falive[f as usize] || self.cone_shape(f, p) < 10.0 * CONE_FLOOR {
                 continue;
             }
             let cl = Clearance {

@@ -4,13 +4,13 @@
 //! that gets stuck.
 use crate::grid::LooseGrid;
 use crate::quality::candidate_score;
+use crate::queue::FaceQueue;
 use crate::{RegionFilter, SizeMode};
 use parafront_geom::intersect::triangles_intersect;
 use parafront_geom::*;
 use parafront_mesh::TET_FACES;
 use rustc_hash::FxHashMap;
 use std::cmp::Reverse;
-use std::collections::BinaryHeap;
 
 mod cavity;
 
@@ -158,9 +158,9 @@ struct Front<'a> {
     fowner: Vec<u32>,
     ftries: Vec<u8>,
     fmap: FxHashMap<[u32; 3], u32>,
-    /// AF1's queue: `key << 32 | face`, the key an `f32` size (positive
-    /// floats order as their bits), so one entry is 8 bytes.
-    heap: BinaryHeap<Reverse<u64>>,
+    /// AF1's queue: `key << 32 | face`, the key an `f32` size, so one
+    /// entry is 8 bytes.
+    heap: FaceQueue,
     fgrid: LooseGrid,
     tets: Vec<[u32; 4]>,
     neigh: Vec<u32>,
@@ -289,11 +289,25 @@ fn thin_wedge(f: [u32; 3], fp: [P3; 3], g: [u32; 3], gp: [P3; 3], min: f64) -> b
     let u = perp(fp[i]);
     let w = perp(gp[j]);
     let n = normalize(tri_normal(fp[0], fp[1], fp[2]));
-    let psi = dot(w, n).atan2(dot(w, u));
+    let (y, x) = (dot(w, n), dot(w, u));
     // On the tet's side, a tiny angle means two near-coplanar faces whose
     // crossing the exact test may see as a miss by rounding (a flat quad
-    // cut by both diagonals).
-    psi.abs() < min
+    // cut by both diagonals). For x > 0 and min <= 0.1, |atan2(y, x)| < min
+    // iff |y|/x < tan(min), in [min, min (1 + min^2 / 2)]: atan2 (slow)
+    // decides only in between.
+    if x < 0.0 {
+        return false;
+    }
+    if x > 0.0 && min <= 0.1 {
+        let r = y.abs() / x;
+        if r < min * (1.0 - 1e-9) {
+            return true;
+        }
+        if r > min * (1.0 + 0.5 * min * min) * (1.0 + 1e-9) {
+            return false;
+        }
+    }
+    y.atan2(x).abs() < min
 }
 
 /// The four face planes of a tet, for a float filter ahead of the exact
@@ -376,6 +390,29 @@ fn heap_entry(key: f64, face: u32) -> Reverse<u64> {
     Reverse(((key as f32).to_bits() as u64) << 32 | face as u64)
 }
 
+#[inline]
+fn box_dist2(b: &Aabb, p: P3) -> f64 {
+    let mut d2 = 0.0;
+    for k in 0..3 {
+        let d = (b.min[k] - p[k]).max(p[k] - b.max[k]).max(0.0);
+        d2 += d * d;
+    }
+    d2
+}
+
+fn median(h: &[f64]) -> f64 {
+    let mut h: Vec<f64> = h
+        .iter()
+        .copied()
+        .filter(|x| *x > 0.0 && x.is_finite())
+        .collect();
+    if h.is_empty() {
+        return f64::NAN;
+    }
+    let k = h.len() / 2;
+    *h.select_nth_unstable_by(k, f64::total_cmp).1
+}
+
 fn tri_box(p: &[P3], v: [u32; 3]) -> Aabb {
     let mut b = Aabb::EMPTY;
     for &i in &v {
@@ -407,6 +444,11 @@ pub fn advance(
     } else {
         bb.diagonal().max(1e-300) * 1e-3
     };
+    let h_ref = median(&input.point_size)
+        * match size {
+            SizeMode::Growth(c) => c,
+            SizeMode::Field(_) => 1.0,
+        };
     let mut f = Front {
         pts: input.points,
         hp: input.point_size,
@@ -416,7 +458,7 @@ pub fn advance(
         fowner: Vec::new(),
         ftries: Vec::new(),
         fmap: FxHashMap::default(),
-        heap: BinaryHeap::new(),
+        heap: FaceQueue::new(h_ref),
         fgrid: LooseGrid::new(s0, bb.min),
         tets: Vec::new(),
         neigh: Vec::new(),
@@ -495,9 +537,7 @@ impl<'a> Front<'a> {
         self.fowner.push(owner);
         self.ftries.push(0);
         self.fmap.insert(sorted3(v), id);
-        let bb = tri_box(&self.pts, v);
-        let ext = (0..3).map(|k| bb.max[k] - bb.min[k]).fold(0.0, f64::max);
-        self.fgrid.insert(id, bb.center(), ext);
+        self.fgrid.insert(id, &tri_box(&self.pts, v));
         let key = self.face_key(v);
         self.heap.push(heap_entry(key, id));
     }
@@ -508,7 +548,7 @@ impl<'a> Front<'a> {
         self.falive[i] = false;
         let v = self.fv[i];
         self.fmap.remove(&sorted3(v));
-        self.fgrid.remove(id);
+        self.fgrid.remove(id, &tri_box(&self.pts, v));
     }
 
     /// The front faces (all but `skip`) whose boxes meet `q`, and the
@@ -990,8 +1030,11 @@ impl<'a> Front<'a> {
             // The apex keeps clear of front faces too, not only of front
             // points: a long face has its corners far away, and a tet that
             // hovers over its middle leaves a slab only slivers can fill.
+            // The box is a cheap lower bound on the distance (kept with a
+            // slack so that rounding cannot decide differently).
             if m_apex > 0.0
                 && !g.contains(&q)
+                && box_dist2(&nf.bb, pq) < m_apex * m_apex * (1.0 + 1e-9)
                 && point_triangle_dist2(pq, gp[0], gp[1], gp[2]) < m_apex * m_apex
             {
                 return false;
