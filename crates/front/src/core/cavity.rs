@@ -131,6 +131,14 @@ impl<'a> Front<'a> {
             {
                 return Pocket::Filled;
             }
+            tracing::trace!(
+                round,
+                faces = pocket.len(),
+                bad = bad.len(),
+                dead = dead.len(),
+                worst = self.worst_cone(&pocket, p),
+                "pocket"
+            );
             if dead.is_empty() || round + 1 == MAX_GROWTH {
                 // Only input faces are seen badly, or growth is not
                 // converging: cone what the point sees well.
