@@ -146,8 +146,7 @@ fn a_pass_hands_its_front_to_the_next() {
 #[test]
 fn a_failed_front_hands_back_its_partial_mesh() {
     let s = generate::torus([0.0; 3], 2.0, 0.6, 32, 12);
-    // At 0.3 the layer-by-layer queue closes this torus without recovery.
-    let field = |_p: P3| 0.45;
+    let field = |_p: P3| 0.3;
     let opts = FrontOptions {
         recovery_rounds: 0,
         keep_partial: true,

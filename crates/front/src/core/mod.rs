@@ -4,13 +4,13 @@
 //! that gets stuck.
 use crate::grid::LooseGrid;
 use crate::quality::candidate_score;
-use crate::queue::FaceQueue;
 use crate::{RegionFilter, SizeMode};
 use parafront_geom::intersect::triangles_intersect;
 use parafront_geom::*;
 use parafront_mesh::TET_FACES;
 use rustc_hash::FxHashMap;
 use std::cmp::Reverse;
+use std::collections::BinaryHeap;
 
 mod cavity;
 
@@ -158,9 +158,9 @@ struct Front<'a> {
     fowner: Vec<u32>,
     ftries: Vec<u8>,
     fmap: FxHashMap<[u32; 3], u32>,
-    /// AF1's queue: `key << 32 | face`, the key an `f32` size, so one
-    /// entry is 8 bytes.
-    heap: FaceQueue,
+    /// AF1's queue: `key << 32 | face`, the key an `f32` size (positive
+    /// floats order as their bits), so one entry is 8 bytes.
+    heap: BinaryHeap<Reverse<u64>>,
     fgrid: LooseGrid,
     tets: Vec<[u32; 4]>,
     neigh: Vec<u32>,
@@ -400,19 +400,6 @@ fn box_dist2(b: &Aabb, p: P3) -> f64 {
     d2
 }
 
-fn median(h: &[f64]) -> f64 {
-    let mut h: Vec<f64> = h
-        .iter()
-        .copied()
-        .filter(|x| *x > 0.0 && x.is_finite())
-        .collect();
-    if h.is_empty() {
-        return f64::NAN;
-    }
-    let k = h.len() / 2;
-    *h.select_nth_unstable_by(k, f64::total_cmp).1
-}
-
 fn tri_box(p: &[P3], v: [u32; 3]) -> Aabb {
     let mut b = Aabb::EMPTY;
     for &i in &v {
@@ -444,11 +431,6 @@ pub fn advance(
     } else {
         bb.diagonal().max(1e-300) * 1e-3
     };
-    let h_ref = median(&input.point_size)
-        * match size {
-            SizeMode::Growth(c) => c,
-            SizeMode::Field(_) => 1.0,
-        };
     let mut f = Front {
         pts: input.points,
         hp: input.point_size,
@@ -458,7 +440,7 @@ pub fn advance(
         fowner: Vec::new(),
         ftries: Vec::new(),
         fmap: FxHashMap::default(),
-        heap: FaceQueue::new(h_ref),
+        heap: BinaryHeap::new(),
         fgrid: LooseGrid::new(s0, bb.min),
         tets: Vec::new(),
         neigh: Vec::new(),
