@@ -327,16 +327,25 @@ impl Work<'_> {
         }
     }
 
+    /// Why point `p` may not move (gone, or on the surface or an
+    /// interface), if it may not.
+    fn pinned(&self, p: PointId) -> Option<Outcome> {
+        if self.dead_pt[p.idx()] {
+            Some(Outcome::NotFound)
+        } else if self.frozen[p.idx()] {
+            Some(Outcome::Frozen)
+        } else {
+            None
+        }
+    }
+
     /// §9.3 Laplacian smoothing of one point with move rejection: `p` goes
     /// towards the mean of its neighbours (full, half, quarter step); a move
     /// is kept only when no tet inverts and the ball's worst quality does
     /// not drop (and its mean rises).
     pub(crate) fn smooth_point(&mut self, p: PointId, s: &mut Scratch) -> Outcome {
-        if self.dead_pt[p.idx()] {
-            return Outcome::NotFound;
-        }
-        if self.frozen[p.idx()] {
-            return Outcome::Frozen;
+        if let Some(o) = self.pinned(p) {
+            return o;
         }
         let mut ball = std::mem::take(&mut s.ball);
         self.ball(p, &mut ball);
@@ -413,11 +422,8 @@ impl Work<'_> {
     /// Moves free point `p` to `pos` if no tet inverts and the worst
     /// quality of its ball does not drop.
     pub(crate) fn try_move(&mut self, p: PointId, pos: P3, s: &mut Scratch) -> Outcome {
-        if self.dead_pt[p.idx()] {
-            return Outcome::NotFound;
-        }
-        if self.frozen[p.idx()] {
-            return Outcome::Frozen;
+        if let Some(o) = self.pinned(p) {
+            return o;
         }
         let mut ball = std::mem::take(&mut s.ball);
         self.ball(p, &mut ball);
@@ -441,11 +447,8 @@ impl Work<'_> {
     /// at a few fractions of the edge length; keep the best move if it
     /// raises the worst quality of the ball.
     pub(crate) fn selective_move(&mut self, p: PointId, s: &mut Scratch) -> Outcome {
-        if self.dead_pt[p.idx()] {
-            return Outcome::NotFound;
-        }
-        if self.frozen[p.idx()] {
-            return Outcome::Frozen;
+        if let Some(o) = self.pinned(p) {
+            return o;
         }
         let mut ball = std::mem::take(&mut s.ball);
         self.ball(p, &mut ball);

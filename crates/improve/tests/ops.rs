@@ -31,16 +31,6 @@ fn tris(m: &TetMesh) -> Vec<[u32; 3]> {
     m.bnd_tris.iter().map(|t| t.map(|p| p.0)).collect()
 }
 
-fn volume(m: &TetMesh) -> f64 {
-    m.tets
-        .iter()
-        .map(|t| {
-            let p = t.map(|x| m.points[x.idx()]);
-            tet_volume6(p[0], p[1], p[2], p[3]) / 6.0
-        })
-        .sum()
-}
-
 fn worst(m: &TetMesh) -> f64 {
     m.tets
         .iter()
@@ -52,7 +42,7 @@ fn worst(m: &TetMesh) -> f64 {
 /// floating point too.
 fn assert_same_domain(m: &TetMesh, tris: &[[u32; 3]], vol: f64) {
     m.check_against_surface(tris).unwrap();
-    assert!((volume(m) - vol).abs() <= 1e-12 * vol.abs());
+    assert!((m.volume() - vol).abs() <= 1e-12 * vol.abs());
     for t in &m.tets {
         let p = t.map(|x| m.points[x.idx()]);
         assert!(tet_volume6(p[0], p[1], p[2], p[3]) > 0.0);
@@ -92,7 +82,7 @@ fn two_three_swap_of_two_flat_tets() {
         [0.0, 0.0, 0.3],
     ];
     let mut m = mesh(pts, &[[0, 1, 2, 4], [0, 2, 1, 3]]);
-    let (tr, vol, q0) = (tris(&m), volume(&m), worst(&m));
+    let (tr, vol, q0) = (tris(&m), m.volume(), worst(&m));
     let mut imp = Improver::new(&mut m, &[]).unwrap();
     // Tet 0's face opposite its apex (point 4).
     let f = imp.mesh().tets[0].iter().position(|p| p.0 == 4).unwrap();
@@ -112,7 +102,7 @@ fn two_three_swap_of_two_flat_tets() {
 fn three_two_swap_of_a_long_edge() {
     // Three tets around a long edge: two tets on the triangle are better.
     let mut m = ring_mesh(3, 1.5);
-    let (tr, vol, q0) = (tris(&m), volume(&m), worst(&m));
+    let (tr, vol, q0) = (tris(&m), m.volume(), worst(&m));
     let mut imp = Improver::new(&mut m, &[]).unwrap();
     assert_eq!(imp.remove_edge(0, PointId(3), PointId(4)), Outcome::Done);
     imp.finish();
@@ -150,7 +140,7 @@ fn brute_best(pts: &[P3], n: usize, a: P3, b: P3) -> f64 {
 fn edge_removal_of_rings_of_five_and_six() {
     for n in [5, 6] {
         let mut m = ring_mesh(n, 2.0);
-        let (tr, vol, q0) = (tris(&m), volume(&m), worst(&m));
+        let (tr, vol, q0) = (tris(&m), m.volume(), worst(&m));
         let best = brute_best(&m.points[..n], n, m.points[n], m.points[n + 1]);
         assert!(best > q0, "n={n}: the ring test case should be improvable");
         let mut imp = Improver::new(&mut m, &[]).unwrap();
@@ -238,7 +228,7 @@ fn collapse_of_a_point_next_to_another() {
     let mut m = dented_ball();
     m.points[0] = [0.25, 0.0, 0.0];
     m.check().unwrap();
-    let (tr, vol, q0) = (tris(&m), volume(&m), worst(&m));
+    let (tr, vol, q0) = (tris(&m), m.volume(), worst(&m));
     let mut imp = Improver::new(&mut m, &[]).unwrap();
     assert_eq!(imp.collapse(PointId(0), PointId(3)), Outcome::Done);
     imp.finish();
@@ -272,7 +262,7 @@ fn smoothing_raises_the_worst_tet() {
     let mut m = dented_ball();
     m.points[0] = [-0.05, 0.0, 0.9];
     m.check().unwrap();
-    let (tr, vol, q0) = (tris(&m), volume(&m), worst(&m));
+    let (tr, vol, q0) = (tris(&m), m.volume(), worst(&m));
     let mut imp = Improver::new(&mut m, &[]).unwrap();
     assert_eq!(imp.smooth_point(PointId(0)), Outcome::Done);
     imp.finish();

@@ -41,6 +41,17 @@ impl TetMesh {
     pub fn region_of(&self, t: TetId) -> u32 {
         self.region.get(t.idx()).copied().unwrap_or(0)
     }
+    /// Sum of the tet volumes (floating point): equals the enclosed volume
+    /// of the boundary when the mesh fills it.
+    pub fn volume(&self) -> f64 {
+        self.tets
+            .iter()
+            .map(|t| {
+                let p = t.map(|x| self.points[x.idx()]);
+                parafront_geom::tet_volume6(p[0], p[1], p[2], p[3]) / 6.0
+            })
+            .sum()
+    }
     /// Appends a point and returns its id.
     pub fn push_point(&mut self, p: P3) -> PointId {
         self.points.push(p);

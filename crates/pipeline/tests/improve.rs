@@ -2,21 +2,10 @@
 //! the surface and the volume stay exactly as they were, the tail of poor
 //! tets shrinks, the worst tet gets no worse, and the result is
 //! deterministic.
-use parafront_geom::tet_volume6;
 use parafront_improve::{improve, ImproveOptions};
 use parafront_mesh::{QualityReport, TetMesh};
 use parafront_pipeline::{mesh_surface, MeshOptions};
 use parafront_surface::{generate, Surface};
-
-fn volume(m: &TetMesh) -> f64 {
-    m.tets
-        .iter()
-        .map(|t| {
-            let p = t.map(|x| m.points[x.idx()]);
-            tet_volume6(p[0], p[1], p[2], p[3]) / 6.0
-        })
-        .sum()
-}
 
 fn front_mesh(s: &Surface) -> TetMesh {
     let opts = MeshOptions {
@@ -50,7 +39,7 @@ fn check_improves(name: &str, s: &Surface) {
     // Surface points keep their ids and places; the boundary is the input.
     assert_eq!(m.points[..s.points.len()], m0.points[..s.points.len()]);
     assert_eq!(m.bnd_tris, m0.bnd_tris);
-    let (v0, v) = (volume(&m0), volume(&m));
+    let (v0, v) = (m0.volume(), m.volume());
     assert!((v - v0).abs() <= 1e-12 * v0, "{name}: volume {v0} -> {v}");
     assert!(
         q.share_min_dihedral_below < q0.share_min_dihedral_below,
@@ -131,7 +120,7 @@ fn parallel_parts_are_valid_and_independent_of_threads() {
     assert_eq!(m1.tets, m3.tets);
     assert_eq!(m1.points, m3.points);
     m1.check_against_surface(&s.tris).unwrap();
-    let (v0, v) = (volume(&m0), volume(&m1));
+    let (v0, v) = (m0.volume(), m1.volume());
     assert!((v - v0).abs() <= 1e-12 * v0);
     assert_eq!(m1.points[..s.points.len()], m0.points[..s.points.len()]);
     let q = QualityReport::new(&m1);
