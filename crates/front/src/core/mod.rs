@@ -143,6 +143,9 @@ enum Outcome {
 struct Near {
     v: [u32; 3],
     bb: Aabb,
+    /// Its corners: gather loads them anyway, and each candidate tet
+    /// would load them again from all over `pts`.
+    p: [P3; 3],
 }
 
 struct Front<'a> {
@@ -543,21 +546,25 @@ impl<'a> Front<'a> {
         let epoch = self.epoch;
         self.fgrid.query(q, |g| {
             let w = self.fv[g as usize];
-            let bb = tri_box(&self.pts, w);
+            let p = w.map(|i| self.pts[i as usize]);
+            let mut bb = Aabb::EMPTY;
+            for x in p {
+                bb.grow(x);
+            }
             if !bb.overlaps(q) {
                 return;
             }
-            for &p in &w {
-                let s = &mut stamp[p as usize];
+            for k in 0..3 {
+                let s = &mut stamp[w[k] as usize];
                 if *s != epoch {
                     *s = epoch;
-                    if q.contains(self.pts[p as usize]) {
-                        near_p.push(p);
+                    if q.contains(p[k]) {
+                        near_p.push(w[k]);
                     }
                 }
             }
             if g != skip {
-                near_f.push(Near { v: w, bb })
+                near_f.push(Near { v: w, bb, p })
             }
         });
         self.stamp = stamp;
@@ -938,7 +945,7 @@ impl<'a> Front<'a> {
             if !nf.bb.overlaps(&rb) {
                 continue;
             }
-            let g = nf.v.map(|i| self.pts[i as usize]);
+            let g = nf.p;
             // Moller-Trumbore; faces through m (t ~ 0) are the neighbours.
             let e1 = sub(g[1], g[0]);
             let e2 = sub(g[2], g[0]);
@@ -995,7 +1002,7 @@ impl<'a> Front<'a> {
                 continue;
             }
             let g = nf.v;
-            let gp = g.map(|i| self.pts[i as usize]);
+            let gp = nf.p;
             let gl = g.map(|x| tv.iter().position(|&y| y == x).unwrap_or(4));
             let apart = planes.separates(&gp, gl);
             // The apex keeps clear of front faces too, not only of front
