@@ -995,16 +995,17 @@ impl<'a> Front<'a> {
         for p in tp {
             tb.grow(p);
         }
-        let new_faces: [[usize; 3]; 3] = [TET_FACES[0], TET_FACES[1], TET_FACES[2]];
+        // The three new faces, built once rather than per near face.
+        let nfv: [[u32; 3]; 3] = [0, 1, 2].map(|i| TET_FACES[i].map(|k| tv[k]));
+        let nfp: [[P3; 3]; 3] = [0, 1, 2].map(|i| TET_FACES[i].map(|k| tp[k]));
         let planes = SeparatingPlanes::new(&tp);
         for nf in near_f {
             if !nf.bb.overlaps(&tb) {
                 continue;
             }
             let g = nf.v;
-            let gp = nf.p;
+            let gp = &nf.p;
             let gl = g.map(|x| tv.iter().position(|&y| y == x).unwrap_or(4));
-            let apart = planes.separates(&gp, gl);
             // The apex keeps clear of front faces too, not only of front
             // points: a long face has its corners far away, and a tet that
             // hovers over its middle leaves a slab only slivers can fill.
@@ -1017,8 +1018,12 @@ impl<'a> Front<'a> {
             {
                 return false;
             }
-            for lf in &new_faces {
-                let fvid = lf.map(|k| tv[k]);
+            let apart = planes.separates(gp, gl);
+            if apart && gl == [4; 3] {
+                continue; // no shared corner: no matching face, no wedge
+            }
+            for i in 0..3 {
+                let fvid = nfv[i];
                 let shared = fvid.iter().filter(|x| g.contains(x)).count();
                 if shared == 3 {
                     // A matching face must face the other way (AF5).
@@ -1027,16 +1032,13 @@ impl<'a> Front<'a> {
                     }
                     continue;
                 }
-                if shared == 2
-                    && cl.wedge > 0.0
-                    && thin_wedge(fvid, lf.map(|k| tp[k]), g, gp, cl.wedge)
-                {
+                if shared == 2 && cl.wedge > 0.0 && thin_wedge(fvid, nfp[i], g, *gp, cl.wedge) {
                     return false;
                 }
                 if apart {
                     continue;
                 }
-                let (fp, gq) = shared_first(fvid, lf.map(|k| tp[k]), g, gp);
+                let (fp, gq) = shared_first(fvid, nfp[i], g, *gp);
                 if triangles_intersect(fp, gq, shared) {
                     return false;
                 }
