@@ -147,6 +147,9 @@ enum Outcome {
 struct Near {
     v: [u32; 3],
     bb: Aabb,
+    /// Its corners: gather loads them anyway, and each candidate tet
+    /// would load them again from all over `pts`.
+    p: [P3; 3],
 }
 
 struct Front<'a> {
@@ -547,21 +550,25 @@ impl<'a> Front<'a> {
         let epoch = self.epoch;
         self.fgrid.query(q, |g| {
             let w = self.fv[g as usize];
-            let bb = tri_box(&self.pts, w);
+            let p = w.map(|i| self.pts[i as usize]);
+            let mut bb = Aabb::EMPTY;
+            for x in p {
+                bb.grow(x);
+            }
             if !bb.overlaps(q) {
                 return;
             }
-            for &p in &w {
-                let s = &mut stamp[p as usize];
+            for k in 0..3 {
+                let s = &mut stamp[w[k] as usize];
                 if *s != epoch {
                     *s = epoch;
-                    if q.contains(self.pts[p as usize]) {
-                        near_p.push(p);
+                    if q.contains(p[k]) {
+                        near_p.push(w[k]);
                     }
                 }
             }
             if g != skip {
-                near_f.push(Near { v: w, bb })
+                near_f.push(Near { v: w, bb, p })
             }
         });
         self.stamp = stamp;
@@ -942,7 +949,7 @@ impl<'a> Front<'a> {
             if !nf.bb.overlaps(&rb) {
                 continue;
             }
-            let g = nf.v.map(|i| self.pts[i as usize]);
+            let g = nf.p;
             // Moller-Trumbore; faces through m (t ~ 0) are the neighbours.
             let e1 = sub(g[1], g[0]);
             let e2 = sub(g[2], g[0]);
@@ -992,7 +999,9 @@ impl<'a> Front<'a> {
         for p in tp {
             tb.grow(p);
         }
-        let new_faces: [[usize; 3]; 3] = [TET_FACES[0], TET_FACES[1], TET_FACES[2]];
+        // The three new faces, built once rather than per near face.
+        let nfv: [[u32; 3]; 3] = [0, 1, 2].map(|i| TET_FACES[i].map(|k| tv[k]));
+        let nfp: [[P3; 3]; 3] = [0, 1, 2].map(|i| TET_FACES[i].map(|k| tp[k]));
         let planes = SeparatingPlanes::new(&tp);
         let m_apex = if q >= NONE - 3 {
             cl.new_point.max(margin)
@@ -1006,9 +1015,8 @@ impl<'a> Front<'a> {
                 continue;
             }
             let g = nf.v;
-            let gp = g.map(|i| self.pts[i as usize]);
+            let gp = &nf.p;
             let gl = g.map(|x| tv.iter().position(|&y| y == x).unwrap_or(4));
-            let apart = planes.separates(&gp, gl);
             // The apex keeps clear of front faces too, not only of front
             // points: a long face has its corners far away, and a tet that
             // hovers over its middle leaves a slab only slivers can fill.
@@ -1024,7 +1032,7 @@ impl<'a> Front<'a> {
             // Nor may a new edge pass close by a front edge: two edges
             // crossing a hair apart leave a slab between their faces that
             // only slivers fill (thin plates of CAD needles).
-            if em > 0.0 && !planes.clear_of(&gp, em) {
+            if em > 0.0 && !planes.clear_of(gp, em) {
                 for e in 0..3 {
                     let a = tv[e];
                     for k in 0..3 {
@@ -1041,8 +1049,12 @@ impl<'a> Front<'a> {
                     }
                 }
             }
-            for lf in &new_faces {
-                let fvid = lf.map(|k| tv[k]);
+            let apart = planes.separates(gp, gl);
+            if apart && gl == [4; 3] {
+                continue; // no shared corner: no matching face, no wedge
+            }
+            for i in 0..3 {
+                let fvid = nfv[i];
                 let shared = fvid.iter().filter(|x| g.contains(x)).count();
                 if shared == 3 {
                     // A matching face must face the other way (AF5).
@@ -1051,16 +1063,13 @@ impl<'a> Front<'a> {
                     }
                     continue;
                 }
-                if shared == 2
-                    && cl.wedge > 0.0
-                    && thin_wedge(fvid, lf.map(|k| tp[k]), g, gp, cl.wedge)
-                {
+                if shared == 2 && cl.wedge > 0.0 && thin_wedge(fvid, nfp[i], g, *gp, cl.wedge) {
                     return false;
                 }
                 if apart {
                     continue;
                 }
-                let (fp, gq) = shared_first(fvid, lf.map(|k| tp[k]), g, gp);
+                let (fp, gq) = shared_first(fvid, nfp[i], g, *gp);
                 if triangles_intersect(fp, gq, shared) {
                     return false;
                 }
