@@ -681,9 +681,11 @@ fn is_stuck(res: &parafront_front::FrontResult, f: [u32; 3], filter: &PartFilter
     use parafront_front::RegionFilter;
     use parafront_geom::{add, cross, dist, normalize, scale, sub};
     let p = f.map(|i| res.points[i as usize]);
-    if !p.iter().all(|&q| filter.point_ok(q))
-        || !(filter.edge_ok(p[0], p[1]) && filter.edge_ok(p[1], p[2]) && filter.edge_ok(p[2], p[0]))
-    {
+    let inside = p.iter().all(|&q| filter.point_ok(q))
+        && filter.edge_ok(p[0], p[1])
+        && filter.edge_ok(p[1], p[2])
+        && filter.edge_ok(p[2], p[0]);
+    if !inside {
         return false;
     }
     let nrm = normalize(cross(sub(p[1], p[0]), sub(p[2], p[0])));
@@ -724,7 +726,8 @@ fn peel_stuck<C: Comm>(parts: &mut [Part], comm: &C) -> usize {
             .wrapping_add(g[2].wrapping_mul(0x1656_67B1_9E37_79F9));
         ((h >> 32) % np as u64) as u32
     };
-    let out: Vec<(usize, Vec<(u32, [Rec; 3])>)> = parts
+    type Out = (usize, Vec<(u32, [Rec; 3])>);
+    let out: Vec<Out> = parts
         .par_iter_mut()
         .map(|part| {
             let (removed, faces) = remove_touching(part, &marked, PEEL_MARKED);
