@@ -140,6 +140,9 @@ struct Part {
     tet_pass: Vec<u8>,
     /// The faces this part holds, local ids.
     front: Vec<[u32; 3]>,
+    /// Global ids of the points of the faces that got stuck in its last
+    /// front call (region rules allowed them, the front could not).
+    stuck: Vec<u32>,
 }
 
 impl Part {
@@ -170,6 +173,8 @@ struct Made {
     input_gid: Vec<u32>,
     /// Input points inside this part (conservative assignment).
     input_ok: Vec<bool>,
+    /// Per face of `res.front`: stuck rather than held by the region.
+    stuck: Vec<bool>,
     seconds: f64,
 }
 
@@ -250,11 +255,25 @@ pub fn mesh_parallel<C: Comm>(
         }
         st.pass_tets[j] = tets.iter().sum();
         st.part_seconds[j] = secs;
-        st.pass_seconds[j] = t0.elapsed().as_secs_f64();
         if std::env::var_os("PARAFRONT_DEBUG_PASSES").is_some() {
-            let fr: Vec<usize> = parts.iter().map(|p| p.front.len()).collect();
-            eprintln!("pass {} tets {:?} front left {:?}", j + 1, tets, fr);
+            let fr: usize = parts.iter().map(|p| p.front.len()).sum();
+            let stuck: usize = parts.iter().map(|p| p.stuck.len() / 3).sum();
+            eprintln!(
+                "pass {} tets {:?} front left {fr}, {stuck} stuck",
+                j + 1,
+                tets
+            );
         }
+        // Room for the next pass around what this one left stuck.
+        let peeled = peel_stuck(&mut parts, comm);
+        if std::env::var_os("PARAFRONT_DEBUG_PASSES").is_some() {
+            eprintln!(
+                "after pass {}: {peeled} tets peeled around stuck faces",
+                j + 1
+            );
+        }
+        st.peeled_tets += peeled;
+        st.pass_seconds[j] = t0.elapsed().as_secs_f64();
     }
     let mean = made_per_part.iter().sum::<usize>() as f64 / np as f64;
     st.made_imbalance = if mean > 0.0 {
@@ -267,7 +286,7 @@ pub fn mesh_parallel<C: Comm>(
     let t0 = Instant::now();
     let (made4, removed) = serial_pass(&mut parts, comm, size, &mut next_gid)?;
     st.pass_tets[3] = made4;
-    st.peeled_tets = removed;
+    st.peeled_tets += removed;
     st.pass_seconds[3] = t0.elapsed().as_secs_f64();
 
     // §8 step 4.
@@ -407,6 +426,7 @@ fn front_call(
             res: None,
             input_gid: Vec::new(),
             input_ok: Vec::new(),
+            stuck: Vec::new(),
             seconds: 0.0,
         });
     }
@@ -458,10 +478,16 @@ fn front_call(
         |i| i as usize >= n_in || input_ok[i as usize],
         size,
     );
+    let stuck = res
+        .front
+        .iter()
+        .map(|f| is_stuck(&res, *f, &filter))
+        .collect();
     Ok(Made {
         res: Some(res),
         input_gid: gids,
         input_ok,
+        stuck,
         seconds: t0.elapsed().as_secs_f64(),
     })
 }
@@ -632,9 +658,13 @@ fn absorb(part: &mut Part, m: Made, base: u32, pass: u8) -> usize {
         })
         .collect();
     let ok = |i: u32| (i as usize) >= n_in || m.input_ok[i as usize];
-    for f in &r.front {
+    for (j, f) in r.front.iter().enumerate() {
         if f.iter().all(|&i| ok(i)) {
             part.front.push(f.map(|i| map[i as usize]));
+            if m.stuck.get(j) == Some(&true) {
+                part.stuck
+                    .extend(f.map(|i| part.gid[map[i as usize] as usize]));
+            }
         }
     }
     for t in &r.tets {
@@ -644,140 +674,124 @@ fn absorb(part: &mut Part, m: Made, base: u32, pass: u8) -> usize {
     r.tets.len()
 }
 
-/// Layers peeled around the front before pass 4 gives up.
-const MAX_PEEL: usize = 4;
-
-/// Pass 4: every part sends what is left of its front to part 0, which
-/// closes it with the serial front (recovery on). What passes 1 to 3 left
-/// are faces the front could not advance without recovery, and recovery
-/// can only remove tets of its own call: so the parts first remove the
-/// tets touching the left-over front (one layer, one more per try when the
-/// serial front still gets stuck) and send their faces along.
-/// Returns the tets made and the tets removed.
-fn serial_pass<C: Comm>(
-    parts: &mut [Part],
-    comm: &C,
-    size: &(dyn Fn(P3) -> f64 + Sync),
-    next_gid: &mut u32,
-) -> Result<(usize, usize), PassError> {
-    let out: Vec<Vec<(u32, [Rec; 3])>> = parts
-        .iter_mut()
-        .map(|p| {
-            let faces = std::mem::take(&mut p.front);
-            faces.iter().map(|f| (0u32, f.map(|i| p.rec(i)))).collect()
-        })
-        .collect();
-    let mut hole: Vec<[Rec; 3]> = comm
-        .exchange(out)
-        .swap_remove(0)
-        .into_iter()
-        .map(|m| m.1)
-        .collect();
-    if hole.is_empty() {
-        return Ok((0, 0));
+/// Whether face `f` of a pass's result got stuck: the region rules of §7
+/// let the front try it (points and edges inside, the ideal point inside,
+/// computed as the front does), but no tet was accepted.
+fn is_stuck(res: &parafront_front::FrontResult, f: [u32; 3], filter: &PartFilter) -> bool {
+    use parafront_front::RegionFilter;
+    use parafront_geom::{add, cross, dist, normalize, scale, sub};
+    let p = f.map(|i| res.points[i as usize]);
+    let inside = p.iter().all(|&q| filter.point_ok(q))
+        && filter.edge_ok(p[0], p[1])
+        && filter.edge_ok(p[1], p[2])
+        && filter.edge_ok(p[2], p[0]);
+    if !inside {
+        return false;
     }
-    let mut removed = 0;
-    // The front left over is what the passes could not advance: a first
-    // try without room spends long in recovery, so peel from the start.
-    let mut peel = 1;
-    loop {
-        removed += peel_layer(parts, comm, &mut hole);
-        let mut index: FxHashMap<u32, u32> = FxHashMap::default();
-        let (mut pts, mut hs, mut gids) = (Vec::new(), Vec::new(), Vec::new());
-        let faces: Vec<[u32; 3]> = hole
-            .iter()
-            .map(|v| {
-                v.map(|r| {
-                    *index.entry(r.gid).or_insert_with(|| {
-                        pts.push(r.p);
-                        hs.push(r.h);
-                        gids.push(r.gid);
-                        pts.len() as u32 - 1
-                    })
-                })
-            })
-            .collect();
-        let t0 = Instant::now();
-        let res = advance(
-            FrontInput {
-                points: pts,
-                point_size: hs,
-                faces,
-            },
-            SizeMode::Field(size),
-            &Everywhere,
-            &FrontOptions {
-                // Bounded: peeling a layer is the better next step.
-                recovery_rounds: if peel < MAX_PEEL { 12 } else { 60 },
-                ..FrontOptions::default()
-            },
-        );
-        let res = match res {
-            Ok(r) => r,
-            Err(FrontError::Stuck { .. }) if peel < MAX_PEEL => {
-                peel += 1;
-                continue;
-            }
-            Err(source) => {
-                return Err(PassError::Pass {
-                    pass: 4,
-                    part: 0,
-                    source,
-                })
-            }
-        };
-        let n_new = (res.points.len() - gids.len()) as u32;
-        let m = Made {
-            input_ok: vec![true; gids.len()],
-            input_gid: gids,
-            res: Some(res),
-            seconds: t0.elapsed().as_secs_f64(),
-        };
-        let n = absorb(&mut parts[0], m, *next_gid, 4);
-        *next_gid += n_new;
-        return Ok((n, removed));
-    }
+    let nrm = normalize(cross(sub(p[1], p[0]), sub(p[2], p[0])));
+    let m = [0, 1, 2].map(|k| (p[0][k] + p[1][k] + p[2][k]) / 3.0);
+    let emax = dist(p[0], p[1]).max(dist(p[1], p[2])).max(dist(p[2], p[0]));
+    let h = (f.iter().map(|&i| res.point_size[i as usize]).sum::<f64>() / 3.0).min(2.0 * emax);
+    let dm = (dist(m, p[0]) + dist(m, p[1]) + dist(m, p[2])) / 3.0;
+    let alpha = (h * h - dm * dm).max(0.25 * dm * dm).sqrt();
+    filter.point_ok(add(m, scale(nrm, alpha)))
 }
 
-/// Removes, in every part, the tets that touch a point of `hole` (the
-/// point ids go out by all-gather) and adds their faces to `hole` (sent to
-/// part 0), cancelling the faces that now have the hole on both sides.
-/// Returns the tets removed.
-fn peel_layer<C: Comm>(parts: &mut [Part], comm: &C, hole: &mut Vec<[Rec; 3]>) -> usize {
-    let mut marked: Vec<u32> = hole.iter().flatten().map(|r| r.gid).collect();
+/// Between passes (§7 needs room as much as pass 4 does): a face stuck in
+/// pass j is a face of an older tet, which pass j+1's front cannot remove.
+/// Every part removes its tets with three points or more among the stuck
+/// faces' points (the ids go out by all-gather): the tets on the stuck
+/// faces and those wedged between them. The faces of the removed tets and
+/// the whole front go by an exact key to one part, where opposite pairs
+/// cancel. Returns the tets removed.
+fn peel_stuck<C: Comm>(parts: &mut [Part], comm: &C) -> usize {
+    let np = parts.len();
+    let marked: Vec<Vec<u32>> = parts
+        .iter_mut()
+        .map(|p| std::mem::take(&mut p.stuck))
+        .collect();
+    let mut marked: Vec<u32> = comm.all_gather(marked).concat();
+    if marked.is_empty() {
+        return 0;
+    }
     marked.sort_unstable();
     marked.dedup();
-    // Part 0 holds the hole; every part gets its points.
-    let marked = comm.all_gather(vec![marked; parts.len()]).swap_remove(0);
     let marked: rustc_hash::FxHashSet<u32> = marked.into_iter().collect();
-    // Faces of a positive tet, oriented into the tet (into the hole).
-    const INWARD: [[usize; 3]; 4] = [[1, 3, 2], [0, 2, 3], [0, 3, 1], [0, 1, 2]];
-    let out: Vec<Vec<(u32, [Rec; 3])>> = parts
+    let key_part = |v: &[Rec; 3]| {
+        let mut g = v.map(|r| r.gid as u64);
+        g.sort_unstable();
+        let h = g[0]
+            .wrapping_mul(0x9E37_79B9_7F4A_7C15)
+            .wrapping_add(g[1].wrapping_mul(0xC2B2_AE3D_27D4_EB4F))
+            .wrapping_add(g[2].wrapping_mul(0x1656_67B1_9E37_79F9));
+        ((h >> 32) % np as u64) as u32
+    };
+    type Out = (usize, Vec<(u32, [Rec; 3])>);
+    let out: Vec<Out> = parts
         .par_iter_mut()
         .map(|part| {
-            let mut out = Vec::new();
-            let mut keep_t = Vec::with_capacity(part.tets.len());
-            let mut keep_p = Vec::with_capacity(part.tets.len());
-            for (t, tv) in part.tets.iter().enumerate() {
-                if tv.iter().any(|&i| marked.contains(&part.gid[i as usize])) {
-                    for f in INWARD {
-                        out.push((0u32, f.map(|c| part.rec(tv[c]))));
-                    }
-                } else {
-                    keep_t.push(*tv);
-                    keep_p.push(part.tet_pass[t]);
-                }
+            let (removed, faces) = remove_touching(part, &marked, PEEL_MARKED);
+            let mut out: Vec<(u32, [Rec; 3])> =
+                faces.into_iter().map(|v| (key_part(&v), v)).collect();
+            for f in std::mem::take(&mut part.front) {
+                let v = f.map(|i| part.rec(i));
+                out.push((key_part(&v), v));
             }
-            part.tets = keep_t;
-            part.tet_pass = keep_p;
-            out
+            (removed, out)
         })
         .collect();
-    let inbox = comm.exchange(out).swap_remove(0);
-    let removed = inbox.len() / 4;
-    hole.extend(inbox.into_iter().map(|m| m.1));
-    // Cancel opposite pairs: sort by the unordered triple, then match the
-    // two orientations one for one.
+    let removed = out.iter().map(|o| o.0).sum();
+    let inboxes = comm.exchange(out.into_iter().map(|o| o.1).collect());
+    parts.par_iter_mut().zip(inboxes).for_each(|(part, inbox)| {
+        let mut hole: Vec<[Rec; 3]> = inbox.into_iter().map(|m| m.1).collect();
+        cancel_pairs(&mut hole);
+        part.front = hole.into_iter().map(|v| v.map(|r| part.local(r))).collect();
+    });
+    removed
+}
+
+/// A peel around stuck faces removes the tets with this many points among
+/// theirs. Every tet touching one (a full layer) made pass 4 five times
+/// larger (sphere_1e5, P = 8: 5.0 % against 0.7 %), most of it tets
+/// peeled and made again.
+const PEEL_MARKED: usize = 3;
+
+/// Removes the part's tets with at least `min_marked` points in `marked`
+/// (global ids); returns how many and their faces, oriented into the hole.
+fn remove_touching(
+    part: &mut Part,
+    marked: &rustc_hash::FxHashSet<u32>,
+    min_marked: usize,
+) -> (usize, Vec<[Rec; 3]>) {
+    // Faces of a positive tet, oriented into the tet (into the hole).
+    const INWARD: [[usize; 3]; 4] = [[1, 3, 2], [0, 2, 3], [0, 3, 1], [0, 1, 2]];
+    let mut out = Vec::new();
+    let mut keep_t = Vec::with_capacity(part.tets.len());
+    let mut keep_p = Vec::with_capacity(part.tets.len());
+    for (t, tv) in part.tets.iter().enumerate() {
+        if tv
+            .iter()
+            .filter(|&&i| marked.contains(&part.gid[i as usize]))
+            .count()
+            >= min_marked
+        {
+            for f in INWARD {
+                out.push(f.map(|c| part.rec(tv[c])));
+            }
+        } else {
+            keep_t.push(*tv);
+            keep_p.push(part.tet_pass[t]);
+        }
+    }
+    let removed = part.tets.len() - keep_t.len();
+    part.tets = keep_t;
+    part.tet_pass = keep_p;
+    (removed, out)
+}
+
+/// Cancels opposite pairs of faces (the hole on both sides): sort by the
+/// unordered triple, then match the two orientations one for one.
+fn cancel_pairs(hole: &mut Vec<[Rec; 3]>) {
     let canon = |v: &[Rec; 3]| {
         let g = v.map(|r| r.gid);
         let r = (0..3).min_by_key(|&k| g[k]).unwrap();
@@ -819,5 +833,180 @@ fn peel_layer<C: Comm>(parts: &mut [Part], comm: &C, hole: &mut Vec<[Rec; 3]>) -
         k += 1;
         !drop[k - 1]
     });
+}
+
+/// Layers peeled around the front before pass 4 gives up.
+const MAX_PEEL: usize = 4;
+
+/// Pass 4: every part sends what is left of its front to part 0, which
+/// closes it with the serial front (recovery on). What passes 1 to 3 left
+/// are faces the front could not advance without recovery, and recovery
+/// can only remove tets of its own call: so the parts first remove the
+/// tets touching the left-over front (one layer, one more per try when the
+/// serial front still gets stuck) and send their faces along.
+/// Returns the tets made and the tets removed.
+fn serial_pass<C: Comm>(
+    parts: &mut [Part],
+    comm: &C,
+    size: &(dyn Fn(P3) -> f64 + Sync),
+    next_gid: &mut u32,
+) -> Result<(usize, usize), PassError> {
+    let out: Vec<Vec<(u32, [Rec; 3])>> = parts
+        .iter_mut()
+        .map(|p| {
+            let faces = std::mem::take(&mut p.front);
+            faces.iter().map(|f| (0u32, f.map(|i| p.rec(i)))).collect()
+        })
+        .collect();
+    let mut hole: Vec<[Rec; 3]> = comm
+        .exchange(out)
+        .swap_remove(0)
+        .into_iter()
+        .map(|m| m.1)
+        .collect();
+    if hole.is_empty() {
+        return Ok((0, 0));
+    }
+    let mut removed = 0;
+    // The front left over is what the passes could not advance: a first
+    // try without room spends long in recovery, so peel from the start.
+    // Room first only around the faces that got stuck in a pass (peeled
+    // before pass 4 already); then, when the serial front still gets stuck,
+    // around the faces it could not close.
+    let mut peel = 0;
+    let mut around: Option<Vec<u32>> = None;
+    loop {
+        if peel > 0 {
+            // Around what the last try left, wider on each try (tets with
+            // 3, then 2 points there, then all touching it), or a whole
+            // layer.
+            let m = if around.is_some() {
+                PEEL_MARKED.saturating_sub(peel - 1).max(1)
+            } else {
+                1
+            };
+            removed += peel_layer(parts, comm, &mut hole, around.take(), m);
+        }
+        let mut index: FxHashMap<u32, u32> = FxHashMap::default();
+        let (mut pts, mut hs, mut gids) = (Vec::new(), Vec::new(), Vec::new());
+        let faces: Vec<[u32; 3]> = hole
+            .iter()
+            .map(|v| {
+                v.map(|r| {
+                    *index.entry(r.gid).or_insert_with(|| {
+                        pts.push(r.p);
+                        hs.push(r.h);
+                        gids.push(r.gid);
+                        pts.len() as u32 - 1
+                    })
+                })
+            })
+            .collect();
+        let t0 = Instant::now();
+        let res = advance(
+            FrontInput {
+                points: pts,
+                point_size: hs,
+                faces,
+            },
+            SizeMode::Field(size),
+            &Everywhere,
+            &FrontOptions {
+                // Bounded: peeling a layer is the better next step. The first
+                // try removes only its own tets once: recovery's pocket
+                // filling (round 2 on) trips on some left-over fronts.
+                recovery_rounds: match peel {
+                    0 => 1,
+                    p if p < MAX_PEEL => 12,
+                    _ => 60,
+                },
+                keep_partial: peel < MAX_PEEL,
+                ..FrontOptions::default()
+            },
+        );
+        if std::env::var_os("PARAFRONT_DEBUG_PASSES").is_some() {
+            eprintln!(
+                "pass 4: try {peel} on {} faces, {removed} tets peeled so far: {}",
+                hole.len(),
+                if res.is_ok() { "closed" } else { "stuck" }
+            );
+        }
+        let res = match res {
+            Ok(r) => r,
+            Err(FrontError::Stuck { partial, .. }) if peel < MAX_PEEL => {
+                // The older points of the faces left: recovery could not
+                // remove the tets of the passes around them.
+                let mut g: Vec<u32> = partial
+                    .iter()
+                    .flat_map(|p| p.front.iter().flatten())
+                    .filter(|&&i| (i as usize) < gids.len())
+                    .map(|&i| gids[i as usize])
+                    .collect();
+                g.sort_unstable();
+                g.dedup();
+                if std::env::var_os("PARAFRONT_DEBUG_PASSES").is_some() {
+                    eprintln!(
+                        "pass 4: {} faces left, {} older points",
+                        partial.as_ref().map_or(0, |p| p.front.len()),
+                        g.len()
+                    );
+                }
+                around = (!g.is_empty()).then_some(g);
+                peel += 1;
+                continue;
+            }
+            Err(source) => {
+                return Err(PassError::Pass {
+                    pass: 4,
+                    part: 0,
+                    source,
+                })
+            }
+        };
+        let n_new = (res.points.len() - gids.len()) as u32;
+        let m = Made {
+            stuck: Vec::new(),
+            input_ok: vec![true; gids.len()],
+            input_gid: gids,
+            res: Some(res),
+            seconds: t0.elapsed().as_secs_f64(),
+        };
+        let n = absorb(&mut parts[0], m, *next_gid, 4);
+        *next_gid += n_new;
+        return Ok((n, removed));
+    }
+}
+
+/// Removes, in every part, the tets with `min_marked` points among
+/// `around` (all points of `hole` if `None`; the ids go out by all-gather)
+/// and adds their faces to `hole` (sent to part 0), cancelling the faces
+/// that now have the hole on both sides. Returns the tets removed.
+fn peel_layer<C: Comm>(
+    parts: &mut [Part],
+    comm: &C,
+    hole: &mut Vec<[Rec; 3]>,
+    around: Option<Vec<u32>>,
+    min_marked: usize,
+) -> usize {
+    let marked = around.unwrap_or_else(|| {
+        let mut m: Vec<u32> = hole.iter().flatten().map(|r| r.gid).collect();
+        m.sort_unstable();
+        m.dedup();
+        m
+    });
+    // Part 0 holds the hole; every part gets its points.
+    let marked = comm.all_gather(vec![marked; parts.len()]).swap_remove(0);
+    let marked: rustc_hash::FxHashSet<u32> = marked.into_iter().collect();
+    let out: Vec<Vec<(u32, [Rec; 3])>> = parts
+        .par_iter_mut()
+        .map(|part| {
+            let (_, faces) = remove_touching(part, &marked, min_marked);
+            faces.into_iter().map(|v| (0u32, v)).collect()
+        })
+        .collect();
+    let inbox = comm.exchange(out).swap_remove(0);
+    let removed = inbox.len() / 4;
+    hole.extend(inbox.into_iter().map(|m| m.1));
+    cancel_pairs(hole);
     removed
 }

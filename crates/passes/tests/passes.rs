@@ -93,13 +93,20 @@ fn a_sphere_on_2_4_8_parts() {
             "predicted imbalance {}",
             st.predicted_imbalance
         );
-        if parts == 2 {
-            // A smooth sphere in two halves: pass 4 is a small remainder
-            // (peeled tets included; the 1 % is not reached yet on
-            // a mesh this small, see the report).
-            let share = st.pass_tets[3] as f64 / o.tets.len() as f64;
-            assert!(share < 0.10, "pass 4 made {:.1}%", 100.0 * share);
-        }
+        // Pass 4 is a small remainder (peeled tets included): the stuck
+        // faces of each pass are peeled open for the next one (before:
+        // 4.4, 6.4 and 16 % on 2, 4 and 8 parts of this small sphere).
+        let share = st.pass_tets[3] as f64 / o.tets.len() as f64;
+        let limit = match parts {
+            2 => 0.01,
+            4 => 0.02,
+            _ => 0.05,
+        };
+        assert!(
+            share < limit,
+            "{parts} parts: pass 4 made {:.1}%",
+            100.0 * share
+        );
         // Every part holds tets, and the send/receive lists are symmetric.
         for (k, pc) in o.pieces.iter().enumerate() {
             assert!(!pc.tets.is_empty(), "part {k} holds no tets");
