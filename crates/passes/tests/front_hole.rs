@@ -1,13 +1,12 @@
 //! A front left for pass 4 (closed, no pinch, no duplicate face) on which
-//! the serial front's recovery trips: `fill_pockets` -> `partial_cone` ->
-//! `commit` removes a dead face (`debug_assert!(falive)` in `remove_face`);
-//! in release the run does not end. Made by `a_sphere_on_2_4_8_parts`
-//! (P = 8) with pass 4's first try at 12 recovery rounds. Pass 4 now makes
-//! its first try with one round, which does not reach pocket filling.
+//! the serial front's recovery used to trip: `fill_pockets` ->
+//! `partial_cone` -> `commit` removed a dead face (a failed
+//! `close_by_existing` re-adds the pocket's faces under new ids). Made by
+//! `a_sphere_on_2_4_8_parts` (P = 8) with pass 4's first try at 12
+//! recovery rounds.
 use parafront_front::{advance, Everywhere, FrontInput, FrontOptions, SizeMode};
 
 #[test]
-#[ignore = "front bug in recovery's pocket filling (crates/front/src/core/cavity.rs)"]
 fn the_front_closes_a_pass4_hole_with_recovery() {
     let txt = include_str!("data/pass4_hole_1602.txt");
     let mut l = txt.lines();
