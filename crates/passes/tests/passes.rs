@@ -79,11 +79,11 @@ fn a_sphere_on_2_4_8_parts() {
             st.predicted_imbalance,
             st.held_imbalance
         );
-        // Since the layer-by-layer queue the serial front makes a quarter
-        // fewer tets here, the passes a fifth fewer: 8.4 % apart at 4 parts.
+        // Issue 4 asks for 3 %; this small sphere is 2.3-2.9 % apart on
+        // 2-8 parts.
         let dev = (o.tets.len() as f64 / n1 as f64 - 1.0).abs();
         assert!(
-            dev < 0.12,
+            dev < 0.04,
             "{parts} parts: {} tets, serial {n1}",
             o.tets.len()
         );
