@@ -430,39 +430,26 @@ fn front_call(
             seconds: 0.0,
         });
     }
-    let mut index: FxHashMap<u32, u32> = FxHashMap::default();
-    let mut pts = Vec::new();
-    let mut hs = Vec::new();
-    let mut gids = Vec::new();
-    let mut faces = Vec::with_capacity(inbox.len());
-    for owned in [true, false] {
-        for (_, m) in inbox.iter().filter(|m| m.1.owned == owned) {
-            faces.push(m.v.map(|r| {
-                *index.entry(r.gid).or_insert_with(|| {
-                    pts.push(r.p);
-                    hs.push(r.h);
-                    gids.push(r.gid);
-                    pts.len() as u32 - 1
-                })
-            }));
-        }
-    }
+    // Owned faces first: their points get the low local ids.
+    let (input, gids) = local_front(
+        [true, false]
+            .into_iter()
+            .flat_map(|owned| inbox.iter().filter(move |m| m.1.owned == owned))
+            .map(|(_, m)| &m.v),
+    );
     let filter = PartFilter {
         loc,
         walls,
         part: part_of,
         k,
     };
-    let input_ok: Vec<bool> = pts
+    let input_ok: Vec<bool> = input
+        .points
         .iter()
         .map(|&p| loc.owner(p, part_of) == Some(k))
         .collect();
     let res = advance(
-        FrontInput {
-            points: pts,
-            point_size: hs,
-            faces,
-        },
+        input,
         SizeMode::Field(size),
         &filter,
         &FrontOptions {
@@ -791,6 +778,33 @@ fn remove_touching(
 
 /// Cancels opposite pairs of faces (the hole on both sides): sort by the
 /// unordered triple, then match the two orientations one for one.
+/// A front over global points, numbered locally in the order the points
+/// are first met, with the global id of each local point.
+fn local_front<'a>(faces: impl Iterator<Item = &'a [Rec; 3]>) -> (FrontInput, Vec<u32>) {
+    let mut index: FxHashMap<u32, u32> = FxHashMap::default();
+    let (mut points, mut point_size, mut gids) = (Vec::new(), Vec::new(), Vec::new());
+    let faces = faces
+        .map(|v| {
+            v.map(|r| {
+                *index.entry(r.gid).or_insert_with(|| {
+                    points.push(r.p);
+                    point_size.push(r.h);
+                    gids.push(r.gid);
+                    points.len() as u32 - 1
+                })
+            })
+        })
+        .collect();
+    (
+        FrontInput {
+            points,
+            point_size,
+            faces,
+        },
+        gids,
+    )
+}
+
 fn cancel_pairs(hole: &mut Vec<[Rec; 3]>) {
     let canon = |v: &[Rec; 3]| {
         let g = v.map(|r| r.gid);
@@ -887,28 +901,10 @@ fn serial_pass<C: Comm>(
             };
             removed += peel_layer(parts, comm, &mut hole, around.take(), m);
         }
-        let mut index: FxHashMap<u32, u32> = FxHashMap::default();
-        let (mut pts, mut hs, mut gids) = (Vec::new(), Vec::new(), Vec::new());
-        let faces: Vec<[u32; 3]> = hole
-            .iter()
-            .map(|v| {
-                v.map(|r| {
-                    *index.entry(r.gid).or_insert_with(|| {
-                        pts.push(r.p);
-                        hs.push(r.h);
-                        gids.push(r.gid);
-                        pts.len() as u32 - 1
-                    })
-                })
-            })
-            .collect();
+        let (input, gids) = local_front(hole.iter());
         let t0 = Instant::now();
         let res = advance(
-            FrontInput {
-                points: pts,
-                point_size: hs,
-                faces,
-            },
+            input,
             SizeMode::Field(size),
             &Everywhere,
             &FrontOptions {
