@@ -1,7 +1,7 @@
 //! Weights and the balanced split of the DDG (§6, step 2), and the shifted
 //! partitions of passes 2 and 3 (§7).
 use crate::Ddg;
-use parafront_geom::{tet_volume6, P3};
+use parafront_geom::{tet_volume6, Aabb, P3};
 
 /// Fine tets each DDG tet will hold (§6): its volume over the volume of a
 /// regular tet at the size `h` at its centroid.
@@ -48,17 +48,7 @@ fn split(cen: &[P3], w: &[f64], ids: &mut [u32], first: u32, parts: u32, part: &
         }
         return;
     }
-    let mut lo = [f64::INFINITY; 3];
-    let mut hi = [f64::NEG_INFINITY; 3];
-    for &t in ids.iter() {
-        for k in 0..3 {
-            lo[k] = lo[k].min(cen[t as usize][k]);
-            hi[k] = hi[k].max(cen[t as usize][k]);
-        }
-    }
-    let ax = (0..3)
-        .max_by(|&a, &b| (hi[a] - lo[a]).total_cmp(&(hi[b] - lo[b])))
-        .unwrap();
+    let ax = Aabb::from_points(ids.iter().map(|&t| &cen[t as usize])).longest_axis();
     ids.sort_unstable_by(|&a, &b| {
         cen[a as usize][ax]
             .total_cmp(&cen[b as usize][ax])

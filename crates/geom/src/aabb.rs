@@ -62,6 +62,12 @@ impl Aabb {
             0.5 * (self.min[2] + self.max[2]),
         ]
     }
+    /// The axis of largest extent (the last one on a tie).
+    pub fn longest_axis(&self) -> usize {
+        (0..3)
+            .max_by(|&a, &b| (self.max[a] - self.min[a]).total_cmp(&(self.max[b] - self.min[b])))
+            .unwrap()
+    }
     /// Grown by `d` on every side.
     pub fn inflated(&self, d: f64) -> Aabb {
         Aabb {

@@ -10,7 +10,7 @@
 //! The partition is coordinate bisection of tet centroids behind
 //! [`partition`]; the domain-defining grid's partition can replace it.
 use crate::{run, ImproveStats};
-use parafront_geom::P3;
+use parafront_geom::{Aabb, P3};
 use parafront_mesh::{PointId, TetMesh, TopoError};
 use rayon::prelude::*;
 
@@ -62,17 +62,7 @@ fn bisect(ids: &mut [u32], cent: &[P3], parts: usize, first: u32, out: &mut [u32
         }
         return;
     }
-    let mut lo = [f64::INFINITY; 3];
-    let mut hi = [f64::NEG_INFINITY; 3];
-    for &t in ids.iter() {
-        for k in 0..3 {
-            lo[k] = lo[k].min(cent[t as usize][k]);
-            hi[k] = hi[k].max(cent[t as usize][k]);
-        }
-    }
-    let ax = (0..3)
-        .max_by(|&a, &b| (hi[a] - lo[a]).total_cmp(&(hi[b] - lo[b])))
-        .unwrap_or(0);
+    let ax = Aabb::from_points(ids.iter().map(|&t| &cent[t as usize])).longest_axis();
     let left = parts / 2;
     let k = ids.len() * left / parts;
     ids.select_nth_unstable_by(k, |&a, &b| {
