@@ -187,6 +187,13 @@ struct Front<'a> {
     epoch: u32,
 }
 
+/// A candidate apex that is not a point yet: `NONE - k` codes the k-th
+/// height above the face in `try_face`, `NONE` a cone apex in recovery.
+#[inline]
+fn is_new_point(q: u32) -> bool {
+    q >= NONE - 3
+}
+
 #[inline]
 fn sorted3(v: [u32; 3]) -> [u32; 3] {
     let mut k = v;
@@ -914,7 +921,7 @@ impl<'a> Front<'a> {
             if s < min_score {
                 continue;
             }
-            let pq = if q >= NONE - 3 {
+            let pq = if is_new_point(q) {
                 add(
                     m,
                     scale(nrm, alpha * [1.0, 0.7, 0.45, 0.25][(NONE - q) as usize]),
@@ -1004,7 +1011,7 @@ impl<'a> Front<'a> {
         let nfv: [[u32; 3]; 3] = [0, 1, 2].map(|i| TET_FACES[i].map(|k| tv[k]));
         let nfp: [[P3; 3]; 3] = [0, 1, 2].map(|i| TET_FACES[i].map(|k| tp[k]));
         let planes = SeparatingPlanes::new(&tp);
-        let m_apex = if q >= NONE - 3 {
+        let m_apex = if is_new_point(q) {
             cl.new_point.max(margin)
         } else {
             margin
@@ -1105,7 +1112,7 @@ impl<'a> Front<'a> {
     /// AF3-AF5: add the tet, its new point, and update the front.
     fn commit(&mut self, fid: u32, q: u32, pq: P3) {
         let v = self.fv[fid as usize];
-        let q = if q >= NONE - 3 {
+        let q = if is_new_point(q) {
             let id = self.pts.len() as u32;
             let h = self.new_point_size(v, pq);
             self.pts.push(pq);
