@@ -5,6 +5,7 @@
 
 pub mod aabb;
 pub mod intersect;
+pub mod kernel;
 pub mod predicates;
 pub mod vec3;
 

@@ -18,6 +18,17 @@ const MAX_POCKET: usize = 400;
 const MAX_GROWTH: usize = 12;
 /// Pockets up to this many faces may be closed from their own corners.
 const MAX_EXHAUSTIVE: usize = 24;
+/// The same in late recovery rounds, before any growth.
+const MAX_EXHAUSTIVE_LATE: usize = 64;
+/// Apex checks one exhaustive search may spend.
+const EXHAUSTIVE_BUDGET: usize = 20_000;
+/// Recovery round from which small pockets try their own corners first.
+const EXHAUSTIVE_FROM_ROUND: u32 = 3;
+/// Cones one kernel search may place in a row.
+const MAX_KERNEL_CONES: usize = 24;
+/// Seeds and size of the patches a pocket with no kernel is coned in.
+const MAX_PATCH_SEEDS: usize = 32;
+const MAX_PATCH: usize = 16;
 
 enum Pocket {
     Filled,
@@ -94,6 +105,15 @@ impl<'a> Front<'a> {
             if pocket.len() > MAX_POCKET || pocket.iter().any(|&f| self.prohibited_face(f)) {
                 return Pocket::Failed;
             }
+            if round == 0
+                && self.relax >= EXHAUSTIVE_FROM_ROUND
+                && pocket.len() <= MAX_EXHAUSTIVE_LATE
+                && self.close_by_existing(&pocket, EXHAUSTIVE_BUDGET)
+            {
+                // Recovery has tried the better ways already: a small pocket
+                // that its own corners can close is closed (CAD needles).
+                return Pocket::Filled;
+            }
             let p = self.kernel_point(&pocket);
             let bad: Vec<u32> = pocket
                 .iter()
@@ -127,7 +147,9 @@ impl<'a> Front<'a> {
                 self.commit_cone(&pocket, p);
                 return Pocket::Filled;
             }
-            if dead.is_empty() && pocket.len() <= MAX_EXHAUSTIVE && self.close_by_existing(&pocket)
+            if dead.is_empty()
+                && pocket.len() <= MAX_EXHAUSTIVE
+                && self.close_by_existing(&pocket, EXHAUSTIVE_BUDGET)
             {
                 return Pocket::Filled;
             }
@@ -139,11 +161,28 @@ impl<'a> Front<'a> {
                 worst = self.worst_cone(&pocket, p),
                 "pocket"
             );
+            // Late recovery: growth has had its rounds; flat cones instead.
+            let late = self.relax >= EXHAUSTIVE_FROM_ROUND;
+            if round + 1 == MAX_GROWTH
+                && self.worst_cone(&pocket, p) >= INPUT_BOUND_FLOOR
+                && self.region.point_ok(p)
+                && self.cone_is_free(&pocket, p)
+            {
+                // Growth did not converge but the pocket has a kernel: a
+                // flat cone, for improvement to work on, beats no mesh.
+                self.commit_cone(&pocket, p);
+                return Pocket::Filled;
+            }
             if dead.is_empty() || round + 1 == MAX_GROWTH {
                 // Only input faces are seen badly, or growth is not
                 // converging: cone what the point sees well.
-                return self.partial_cone(&pocket, p);
+                let r = self.partial_cone(&pocket, p);
+                if matches!(r, Pocket::Failed) && late {
+                    return self.kernel_cone(&pocket);
+                }
+                return r;
             }
+
             let before = self.fv.len();
             for &t in &dead {
                 self.talive[t as usize] = false;
@@ -220,57 +259,307 @@ impl<'a> Front<'a> {
         Pocket::Partial
     }
 
-    /// Close a small pocket with tets on its own corners, best first: the
-    /// space between close input faces may need no new point, only tets
-    /// flatter than the front accepts. Undone if it does not close.
-    fn close_by_existing(&mut self, pocket: &[u32]) -> bool {
-        let mut faces: Vec<u32> = pocket.to_vec();
-        let mut made = Vec::new();
-        for _ in 0..4 * pocket.len() {
-            let corners: Vec<u32> = {
-                let mut c: Vec<u32> = faces.iter().flat_map(|&f| self.fv[f as usize]).collect();
-                c.sort_unstable();
-                c.dedup();
-                c
+    /// A pocket with no kernel: drop the faces the deepest point sees
+    /// worst until the rest has a kernel, and cone those from its deepest
+    /// point; the front goes on from the cones' sides. Flat tets are
+    /// allowed (validity is exact): recovery tried better ways first.
+    fn kernel_cone(&mut self, pocket: &[u32]) -> Pocket {
+        let mut cur = pocket.to_vec();
+        let mut made = false;
+        // Cone after cone on what is left, without the growth in between
+        // that would take the last cone out again.
+        for _ in 0..MAX_KERNEL_CONES {
+            let before = self.fv.len() as u32;
+            if !self.kernel_cone_once(&cur) {
+                break;
+            }
+            made = true;
+            let next = cur
+                .iter()
+                .copied()
+                .chain(before..self.fv.len() as u32)
+                .find(|&f| self.falive[f as usize]);
+            let Some(seed) = next else {
+                return Pocket::Filled;
             };
-            let mut best: Option<(f64, u32, u32)> = None;
-            for &f in &faces {
+            cur = self.pocket(seed);
+            if cur.len() > MAX_POCKET {
+                break;
+            }
+            if cur.len() <= MAX_EXHAUSTIVE && self.close_by_existing(&cur, EXHAUSTIVE_BUDGET) {
+                return Pocket::Filled;
+            }
+        }
+        if made {
+            Pocket::Partial
+        } else {
+            Pocket::Failed
+        }
+    }
+
+    /// The deepest point over the planes of `faces`, kept inside `bb`.
+    fn deepest_over(&self, faces: &[u32], bb: &Aabb) -> Option<(P3, f64)> {
+        let mut planes: Vec<(P3, P3)> = faces
+            .iter()
+            .map(|&f| {
+                let [a, b, d] = self.fv[f as usize].map(|i| self.pts[i as usize]);
+                (a, tri_normal(a, b, d))
+            })
+            .collect();
+        for k in 0..3 {
+            let mut n = [0.0; 3];
+            n[k] = 1.0;
+            planes.push((bb.min, n));
+            n[k] = -1.0;
+            planes.push((bb.max, n));
+        }
+        parafront_geom::kernel::deepest_point(&planes)
+    }
+
+    fn faces_box(&self, faces: &[u32]) -> Aabb {
+        let mut bb = Aabb::EMPTY;
+        for &f in faces {
+            for i in self.fv[f as usize] {
+                bb.grow(self.pts[i as usize]);
+            }
+        }
+        bb
+    }
+
+    /// Cone the faces of `set` that `x` sees and whose cones are free.
+    fn cone_from(&mut self, set: &[u32], x: P3) -> bool {
+        if !self.region.point_ok(x) {
+            return false;
+        }
+        let take: Vec<u32> = set
+            .iter()
+            .copied()
+            .filter(|&f| {
+                self.cone_shape(f, x) >= INPUT_BOUND_FLOOR
+                    && self.apex_free(f, NONE, x, Clearance::EXACT)
+            })
+            .collect();
+        if take.is_empty() {
+            return false;
+        }
+        let id = self.pts.len() as u32;
+        self.commit(take[0], NONE, x);
+        for &f in &take[1..] {
+            self.commit(f, id, x);
+        }
+        self.stats.pockets_filled += 1;
+        true
+    }
+
+    /// One cone on part of a pocket with no kernel. First the whole pocket
+    /// less the faces seen worst; if those cones are blocked, a patch grown
+    /// from one face over its neighbours while it keeps a kernel near it.
+    fn kernel_cone_once(&mut self, pocket: &[u32]) -> bool {
+        let mut set: Vec<u32> = pocket
+            .iter()
+            .copied()
+            .filter(|&f| self.falive[f as usize])
+            .collect();
+        let bb = self.faces_box(&set);
+        let tiny = 1e-6 * bb.diagonal();
+        while set.len() >= 4 {
+            let Some((x, depth)) = self.deepest_over(&set, &bb) else {
+                break;
+            };
+            if depth > tiny {
+                if self.cone_from(&set, x) {
+                    return true;
+                }
+                break;
+            }
+            // The face seen worst from `x` leaves (ties: lowest id).
+            let worst = set
+                .iter()
+                .enumerate()
+                .map(|(k, &f)| {
+                    let [a, b, d] = self.fv[f as usize].map(|i| self.pts[i as usize]);
+                    (dot(normalize(tri_normal(a, b, d)), sub(x, a)), k)
+                })
+                .min_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)))
+                .map(|w| w.1)
+                .expect("set is not empty");
+            set.remove(worst);
+        }
+        // Patches: neighbours over shared edges.
+        let live: Vec<u32> = pocket
+            .iter()
+            .copied()
+            .filter(|&f| self.falive[f as usize])
+            .collect();
+        let mut by_edge: FxHashMap<(u32, u32), Vec<u32>> = FxHashMap::default();
+        for &f in &live {
+            let v = self.fv[f as usize];
+            for k in 0..3 {
+                let (a, b) = (v[k], v[(k + 1) % 3]);
+                by_edge.entry((a.min(b), a.max(b))).or_default().push(f);
+            }
+        }
+        for &seed in live.iter().take(MAX_PATCH_SEEDS) {
+            let mut patch = vec![seed];
+            let mut i = 0;
+            let mut best: Option<(P3, f64)> = None;
+            while i < patch.len() && patch.len() < MAX_PATCH {
+                let f = patch[i];
+                i += 1;
                 let v = self.fv[f as usize];
-                let [a, b, c] = v.map(|i| self.pts[i as usize]);
-                for &q in &corners {
-                    if v.contains(&q) {
-                        continue;
-                    }
-                    let shape = mean_ratio(a, b, c, self.pts[q as usize]);
-                    if shape < INPUT_BOUND_FLOOR || best.is_some_and(|b| b.0 >= shape) {
-                        continue;
-                    }
-                    if self.apex_free(f, q, self.pts[q as usize], Clearance::EXACT) {
-                        best = Some((shape, f, q));
+                for k in 0..3 {
+                    let (a, b) = (v[k], v[(k + 1) % 3]);
+                    for &g in &by_edge[&(a.min(b), a.max(b))] {
+                        if patch.contains(&g) || patch.len() >= MAX_PATCH {
+                            continue;
+                        }
+                        patch.push(g);
+                        let pb = self.faces_box(&patch);
+                        let grown = pb.inflated(0.5 * pb.diagonal());
+                        match self.deepest_over(&patch, &grown) {
+                            Some((x, d)) if d > tiny => best = Some((x, d)),
+                            _ => {
+                                patch.pop();
+                            }
+                        }
                     }
                 }
             }
-            let Some((_, f, q)) = best else {
-                break;
-            };
-            let before = self.fv.len() as u32;
-            made.push(self.tets.len() as u32);
-            self.commit(f, q, self.pts[q as usize]);
-            faces.retain(|&g| self.falive[g as usize]);
-            faces.extend((before..self.fv.len() as u32).filter(|&g| self.falive[g as usize]));
-            if faces.is_empty() {
-                self.stats.pockets_filled += 1;
-                return true;
+            if patch.len() < 2 {
+                continue;
+            }
+            if let Some((x, _)) = best {
+                if self.cone_from(&patch, x) {
+                    return true;
+                }
             }
         }
-        // Not closed: take the tets back out; the pocket is as it was.
-        for &t in &made {
-            self.talive[t as usize] = false;
-        }
-        for &t in made.iter().rev() {
-            self.unlink_tet(t);
-        }
         false
+    }
+
+    /// Close a small pocket with tets on its own corners (step 5.3's
+    /// exhaustive search): the space between close input faces may need no
+    /// new point, only tets flatter than the front accepts. Depth first:
+    /// the face with the fewest possible apexes goes first, its apexes best
+    /// first, and a face with none left undoes the tet before it. At most
+    /// `budget` apex checks; undone if it does not close.
+    fn close_by_existing(&mut self, pocket: &[u32], budget: usize) -> bool {
+        struct Level {
+            face: [u32; 3],
+            cands: Vec<u32>,
+            next: usize,
+            tet: u32,
+        }
+        let mut corners: Vec<u32> = pocket.iter().flat_map(|&f| self.fv[f as usize]).collect();
+        corners.sort_unstable();
+        corners.dedup();
+        let mut faces: Vec<u32> = pocket.to_vec();
+        let mut stack: Vec<Level> = Vec::new();
+        let mut left = budget;
+        let mut descend = true;
+        loop {
+            if descend {
+                if faces.is_empty() {
+                    self.stats.pockets_filled += 1;
+                    return true;
+                }
+                // The most constrained face: fewest corners it could reach.
+                let mut pick: Option<(usize, [u32; 3], u32)> = None;
+                for &f in &faces {
+                    let v = self.fv[f as usize];
+                    let [a, b, c] = v.map(|i| self.pts[i as usize]);
+                    let n = corners
+                        .iter()
+                        .filter(|&&q| {
+                            !v.contains(&q)
+                                && mean_ratio(a, b, c, self.pts[q as usize]) >= INPUT_BOUND_FLOOR
+                        })
+                        .count();
+                    let key = sorted3(v);
+                    if pick.is_none_or(|(m, k, _)| n < m || (n == m && key < k)) {
+                        pick = Some((n, key, f));
+                    }
+                }
+                let (_, _, f) = pick.expect("faces is not empty");
+                let v = self.fv[f as usize];
+                let [a, b, c] = v.map(|i| self.pts[i as usize]);
+                let mut cands: Vec<(f64, u32)> = corners
+                    .iter()
+                    .filter(|&&q| !v.contains(&q))
+                    .map(|&q| (mean_ratio(a, b, c, self.pts[q as usize]), q))
+                    .filter(|x| x.0 >= INPUT_BOUND_FLOOR)
+                    .collect();
+                cands.sort_unstable_by(|x, y| y.0.total_cmp(&x.0).then(x.1.cmp(&y.1)));
+                stack.push(Level {
+                    face: v,
+                    cands: cands.into_iter().map(|x| x.1).collect(),
+                    next: 0,
+                    tet: NONE,
+                });
+            }
+            // Try the next apex of the top face.
+            let Some(top) = stack.last_mut() else {
+                return false;
+            };
+            let fid = *self
+                .fmap
+                .get(&sorted3(top.face))
+                .expect("a pocket face is in the front");
+            let mut placed = false;
+            while top.next < top.cands.len() && left > 0 {
+                let q = top.cands[top.next];
+                top.next += 1;
+                left -= 1;
+                let p = self.pts[q as usize];
+                if self.apex_free(fid, q, p, Clearance::EXACT) {
+                    let before = self.fv.len() as u32;
+                    top.tet = self.tets.len() as u32;
+                    self.commit(fid, q, p);
+                    faces.retain(|&g| self.falive[g as usize]);
+                    faces.extend(
+                        (before..self.fv.len() as u32).filter(|&g| self.falive[g as usize]),
+                    );
+                    placed = true;
+                    break;
+                }
+            }
+            if placed {
+                descend = true;
+                continue;
+            }
+            // No apex left here (or no budget): back up one level.
+            stack.pop();
+            descend = false;
+            let undo = stack
+                .last_mut()
+                .map(|l| std::mem::replace(&mut l.tet, NONE));
+            if left == 0 {
+                // Give up: undo every tet made, newest first.
+                let mut made: Vec<u32> =
+                    stack.iter().map(|l| l.tet).filter(|&t| t != NONE).collect();
+                made.extend(undo.filter(|&t| t != NONE));
+                made.sort_unstable();
+                for &t in &made {
+                    self.talive[t as usize] = false;
+                }
+                for &t in made.iter().rev() {
+                    self.unlink_tet(t);
+                }
+                return false;
+            }
+            match undo {
+                Some(t) if t != NONE => {
+                    let before = self.fv.len() as u32;
+                    self.talive[t as usize] = false;
+                    self.unlink_tet(t);
+                    faces.retain(|&g| self.falive[g as usize]);
+                    faces.extend(
+                        (before..self.fv.len() as u32).filter(|&g| self.falive[g as usize]),
+                    );
+                }
+                _ => return false,
+            }
+        }
     }
 
     fn prohibited_face(&self, f: u32) -> bool {
@@ -326,6 +615,20 @@ impl<'a> Front<'a> {
             let nrm = normalize(tri_normal(a, b, d));
             for k in [0.25, 0.5, 0.8] {
                 cands.push(add(m, scale(nrm, k * hmean)));
+            }
+        }
+        // The kernel's deepest point (exact LP): thin pockets have kernels
+        // far smaller than the pattern search's first step.
+        let planes: Vec<(P3, P3)> = pocket
+            .iter()
+            .map(|&f| {
+                let [a, b, d] = self.fv[f as usize].map(|i| self.pts[i as usize]);
+                (a, tri_normal(a, b, d))
+            })
+            .collect();
+        if let Some((x, depth)) = parafront_geom::kernel::deepest_point(&planes) {
+            if depth > 0.0 {
+                cands.push(x);
             }
         }
         let mut best = c;

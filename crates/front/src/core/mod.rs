@@ -24,6 +24,8 @@ const SEARCH_RADIUS: f64 = 0.7;
 /// Recovery rounds without fewer stuck faces before the front gives up: the
 /// skull needs 14 (its stuck set goes 28, 68, 110, ... 48, 16, 0).
 const STALL_ROUNDS: u32 = 20;
+/// Marked points a tet needs to leave in a late recovery round.
+const LATE_REMOVAL_POINTS: usize = 2;
 /// A new tet's size is at most this multiple of its face's longest edge.
 const MAX_GROWTH_PER_TET: f64 = 2.0;
 
@@ -265,9 +267,15 @@ impl Clearance {
                 wedge: 0.03,
                 new_point: NEW_POINT_CLEARANCE[1] * h,
             },
-            _ => Clearance {
+            3 | 4 => Clearance {
                 point: 0.015 * h,
                 wedge: 0.02,
+                new_point: NEW_POINT_CLEARANCE[2] * h,
+            },
+            // Late recovery: validity only, for a front no rule lets close.
+            _ => Clearance {
+                point: 0.0,
+                wedge: 0.0,
                 new_point: NEW_POINT_CLEARANCE[2] * h,
             },
         }
@@ -687,13 +695,20 @@ impl<'a> Front<'a> {
             if self.stuck.is_empty() {
                 return;
             }
-            if progress > 0 && self.relax % 3 != 0 {
+            if progress > 0 {
                 // Partial cones made new faces: the front goes on from them.
                 self.requeue_front();
                 return;
             }
         }
         let layers = 1;
+        // Later rounds take less: only tets on an edge of the stuck faces'
+        // points, so that one stubborn pocket does not undo the rest.
+        let need = if self.relax >= 2 {
+            LATE_REMOVAL_POINTS
+        } else {
+            1
+        };
         let mut mark = vec![false; self.pts.len()];
         for &f in &self.stuck {
             for &p in &self.fv[f as usize] {
@@ -704,7 +719,7 @@ impl<'a> Front<'a> {
         for _ in 0..layers {
             let mut layer = Vec::new();
             for (t, tv) in self.tets.iter().enumerate() {
-                if self.talive[t] && tv.iter().any(|&p| mark[p as usize]) {
+                if self.talive[t] && tv.iter().filter(|&&p| mark[p as usize]).count() >= need {
                     layer.push(t as u32);
                 }
             }
