@@ -29,6 +29,8 @@ const MAX_KERNEL_CONES: usize = 24;
 /// Seeds and size of the patches a pocket with no kernel is coned in.
 const MAX_PATCH_SEEDS: usize = 32;
 const MAX_PATCH: usize = 16;
+/// Worst cone a patch may make before late growth.
+const PATCH_FLOOR: f64 = 0.02;
 
 enum Pocket {
     Filled,
@@ -173,6 +175,12 @@ impl<'a> Front<'a> {
                 self.commit_cone(&pocket, p);
                 return Pocket::Filled;
             }
+            if late && round == 0 {
+                let r = self.kernel_cone_with(&pocket, PATCH_FLOOR);
+                if !matches!(r, Pocket::Failed) {
+                    return r;
+                }
+            }
             if dead.is_empty() || round + 1 == MAX_GROWTH {
                 // Only input faces are seen badly, or growth is not
                 // converging: cone what the point sees well.
@@ -264,13 +272,17 @@ impl<'a> Front<'a> {
     /// point; the front goes on from the cones' sides. Flat tets are
     /// allowed (validity is exact): recovery tried better ways first.
     fn kernel_cone(&mut self, pocket: &[u32]) -> Pocket {
+        self.kernel_cone_with(pocket, INPUT_BOUND_FLOOR)
+    }
+
+    fn kernel_cone_with(&mut self, pocket: &[u32], floor: f64) -> Pocket {
         let mut cur = pocket.to_vec();
         let mut made = false;
         // Cone after cone on what is left, without the growth in between
         // that would take the last cone out again.
         for _ in 0..MAX_KERNEL_CONES {
             let before = self.fv.len() as u32;
-            if !self.kernel_cone_once(&cur) {
+            if !self.kernel_cone_once(&cur, floor) {
                 break;
             }
             made = true;
@@ -327,7 +339,7 @@ impl<'a> Front<'a> {
     }
 
     /// Cone the faces of `set` that `x` sees and whose cones are free.
-    fn cone_from(&mut self, set: &[u32], x: P3) -> bool {
+    fn cone_from(&mut self, set: &[u32], x: P3, floor: f64) -> bool {
         if !self.region.point_ok(x) {
             return false;
         }
@@ -335,7 +347,7 @@ impl<'a> Front<'a> {
             .iter()
             .copied()
             .filter(|&f| {
-                self.cone_shape(f, x) >= INPUT_BOUND_FLOOR
+                self.cone_shape(f, x) >= floor
                     && self.apex_free(f, NONE, x, Clearance::EXACT)
             })
             .collect();
@@ -354,7 +366,7 @@ impl<'a> Front<'a> {
     /// One cone on part of a pocket with no kernel. First the whole pocket
     /// less the faces seen worst; if those cones are blocked, a patch grown
     /// from one face over its neighbours while it keeps a kernel near it.
-    fn kernel_cone_once(&mut self, pocket: &[u32]) -> bool {
+    fn kernel_cone_once(&mut self, pocket: &[u32], floor: f64) -> bool {
         let mut set: Vec<u32> = pocket
             .iter()
             .copied()
@@ -362,12 +374,12 @@ impl<'a> Front<'a> {
             .collect();
         let bb = self.faces_box(&set);
         let tiny = 1e-6 * bb.diagonal();
-        while set.len() >= 4 {
+        while set.len() >= 4 && floor <= INPUT_BOUND_FLOOR {
             let Some((x, depth)) = self.deepest_over(&set, &bb) else {
                 break;
             };
             if depth > tiny {
-                if self.cone_from(&set, x) {
+                if self.cone_from(&set, x, INPUT_BOUND_FLOOR) {
                     return true;
                 }
                 break;
@@ -417,7 +429,12 @@ impl<'a> Front<'a> {
                         let pb = self.faces_box(&patch);
                         let grown = pb.inflated(0.5 * pb.diagonal());
                         match self.deepest_over(&patch, &grown) {
-                            Some((x, d)) if d > tiny => best = Some((x, d)),
+                            Some((x, d))
+                                if d > tiny
+                                    && patch.iter().all(|&f| self.cone_shape(f, x) >= floor) =>
+                            {
+                                best = Some((x, d))
+                            }
                             _ => {
                                 patch.pop();
                             }
@@ -429,7 +446,7 @@ impl<'a> Front<'a> {
                 continue;
             }
             if let Some((x, _)) = best {
-                if self.cone_from(&patch, x) {
+                if self.cone_from(&patch, x, floor) {
                     return true;
                 }
             }
