@@ -50,3 +50,30 @@ fn demo_part_is_deterministic() {
     assert_eq!(a.tets, b.tets);
     assert_eq!(a.points, b.points);
 }
+
+/// CAD needles (fans from the plate's corners to a hole's rim, 0.3-1.4
+/// degree angles): no tet on them is far from flat, so only validity and
+/// the exact fill are asserted. The front of session 4 stopped on the
+/// 5 x 64 plate with 338 faces stuck.
+#[test]
+fn needle_plates_mesh() {
+    for (t, rim) in [(5.0, 64), (1.0, 128), (10.0, 32)] {
+        let s = generate::needle_plate(t, rim);
+        let (m, summary) = mesh_surface(&s, &MeshOptions::default())
+            .unwrap_or_else(|e| panic!("plate {t} x {rim}: meshing failed: {e}"));
+        m.check_against_surface(&s.tris)
+            .unwrap_or_else(|e| panic!("plate {t} x {rim}: invalid mesh: {e}"));
+        let v: f64 = m.volume();
+        assert!(
+            (v - s.signed_volume()).abs() < 1e-9 * v,
+            "plate {t} x {rim}: volume {v} against {}",
+            s.signed_volume()
+        );
+        assert_eq!(QualityReport::new(&m).n_inverted, 0);
+        println!(
+            "plate {t} x {rim}: {} tets, {} recovery rounds",
+            m.tets.len(),
+            summary.recovery_rounds
+        );
+    }
+}

@@ -217,6 +217,86 @@ pub fn demo_part() -> Surface {
     s
 }
 
+/// A CAD-style plate, 50 x 30 x `thickness`, with a round through-hole of
+/// radius 3 faceted by `rim` points, its flat faces triangulated as a CAD
+/// exporter does: fans from the plate's corners to the hole's rim. The fan
+/// triangles are needles (about 25 long, 0.3 wide at 64 rim points), like
+/// those of the hinge and the tray in the corpus.
+pub fn needle_plate(thickness: f64, rim: usize) -> Surface {
+    let (l, w, r) = (50.0, 30.0, 3.0);
+    let (cx, cy) = (l / 2.0, w / 2.0);
+    let corners = [[0.0, 0.0], [l, 0.0], [l, w], [0.0, w]];
+    let ang: Vec<f64> = (0..rim)
+        .map(|i| std::f64::consts::TAU * (i as f64 + 0.5) / rim as f64)
+        .collect();
+    // The corner a rim direction faces: quadrants of the circle.
+    let owner = |a: f64| match (a / std::f64::consts::FRAC_PI_2) as usize {
+        0 => 2,
+        1 => 3,
+        2 => 0,
+        _ => 1,
+    };
+    let mut s = Surface::default();
+    let mut layer = |z: f64, s: &mut Surface| {
+        let c: Vec<u32> = corners
+            .iter()
+            .map(|q| {
+                s.points.push([q[0], q[1], z]);
+                s.points.len() as u32 - 1
+            })
+            .collect();
+        let h: Vec<u32> = ang
+            .iter()
+            .map(|a| {
+                s.points.push([cx + r * a.cos(), cy + r * a.sin(), z]);
+                s.points.len() as u32 - 1
+            })
+            .collect();
+        (c, h)
+    };
+    let (ct, ht) = layer(thickness, &mut s);
+    let (cb, hb) = layer(0.0, &mut s);
+    let mut add = |t: [u32; 3], out: P3, s: &mut Surface| {
+        // Orient by the wanted outward direction.
+        let [a, b, c] = t.map(|i| s.points[i as usize]);
+        let t = if dot(tri_normal(a, b, c), out) > 0.0 {
+            t
+        } else {
+            [t[0], t[2], t[1]]
+        };
+        s.tris.push(t);
+        s.patch.push(0);
+    };
+    for (c, h, up) in [(&ct, &ht, 1.0), (&cb, &hb, -1.0)] {
+        for i in 0..rim {
+            let j = (i + 1) % rim;
+            let (ki, kj) = (owner(ang[i]), owner(ang[j]));
+            if ki != kj {
+                add([c[ki], h[i], c[kj]], [0.0, 0.0, up], &mut s);
+            }
+            add([c[kj], h[i], h[j]], [0.0, 0.0, up], &mut s);
+        }
+    }
+    for k in 0..4 {
+        let (a, b) = (k, (k + 1) % 4);
+        let mid = [
+            0.5 * (corners[a][0] + corners[b][0]) - cx,
+            0.5 * (corners[a][1] + corners[b][1]) - cy,
+            0.0,
+        ];
+        add([cb[a], cb[b], ct[b]], mid, &mut s);
+        add([cb[a], ct[b], ct[a]], mid, &mut s);
+    }
+    for i in 0..rim {
+        let j = (i + 1) % rim;
+        let a = 0.5 * (ang[i] + ang[j]) + if j == 0 { std::f64::consts::PI } else { 0.0 };
+        let inward = [-a.cos(), -a.sin(), 0.0];
+        add([hb[i], hb[j], ht[j]], inward, &mut s);
+        add([hb[i], ht[j], ht[i]], inward, &mut s);
+    }
+    s
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -253,6 +333,13 @@ mod tests {
             "{}",
             block.signed_volume()
         );
+
+        let plate = needle_plate(5.0, 64);
+        assert!(edges_paired(&plate));
+        // The hole is a 64-gon of circumradius 3.
+        let hole = 0.5 * 64.0 * 9.0 * (std::f64::consts::TAU / 64.0).sin();
+        let exact = (50.0 * 30.0 - hole) * 5.0;
+        assert!((plate.signed_volume() - exact).abs() < 1e-9 * exact);
 
         let demo = demo_part();
         assert!(edges_paired(&demo));

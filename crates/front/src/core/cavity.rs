@@ -347,8 +347,7 @@ impl<'a> Front<'a> {
             .iter()
             .copied()
             .filter(|&f| {
-                self.cone_shape(f, x) >= floor
-                    && self.apex_free(f, NONE, x, Clearance::EXACT)
+                self.cone_shape(f, x) >= floor && self.apex_free(f, NONE, x, Clearance::EXACT)
             })
             .collect();
         if take.is_empty() {
