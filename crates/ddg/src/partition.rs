@@ -384,6 +384,146 @@ mod tests {
         }
     }
 
+    fn torus_ddg() -> Ddg {
+        let s = generate::torus([0.0; 3], 1.0, 0.4, 48, 20);
+        let faces: Vec<[u32; 3]> = s.tris.iter().map(|t| [t[0], t[2], t[1]]).collect();
+        crate::build(
+            s.points.clone(),
+            s.mean_edge_lengths(),
+            faces,
+            crate::DEFAULT_GROWTH,
+            crate::DdgMode::default(),
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn metis_balances_connects_and_cuts_less_than_rcb() {
+        // The fine size: finer on one side, so the weights vary.
+        let h = |p: P3| 0.04 + 0.02 * (p[0] + 1.5);
+        for (name, d) in [("sphere", sphere_ddg()), ("torus", torus_ddg())] {
+            let w = tet_weights(&d, &h);
+            for parts in [2usize, 3, 8, 16] {
+                let m = metis_kway(&d, &w, &h, parts);
+                let r = rcb(&d, &w, parts);
+                assert!(m.iter().all(|&k| (k as usize) < parts));
+                let imb = imbalance(&m, &w, parts);
+                // METIS's default tolerance is 3 %; whole DDG tets add a
+                // little on these small grids.
+                assert!(imb < 1.06, "{name}, {parts} parts: imbalance {imb}");
+                let pieces = components(&d, &m, parts);
+                assert!(
+                    pieces.iter().all(|&c| c == 1),
+                    "{name}, {parts} parts: pieces per part {pieces:?}"
+                );
+                let (cm, cr) = (cut_fine_faces(&d, &m, &h), cut_fine_faces(&d, &r, &h));
+                let (fm, fr) = (cut_faces(&d, &m), cut_faces(&d, &r));
+                eprintln!(
+                    "{name}, {parts} parts, {} DDG tets: imbalance metis {imb:.3} rcb {:.3}; cut fine faces metis {cm:.0} rcb {cr:.0}; DDG faces {fm} / {fr}; rcb pieces {:?}",
+                    d.tets.len(),
+                    imbalance(&r, &w, parts),
+                    components(&d, &r, parts)
+                );
+                assert!(
+                    cm < cr,
+                    "{name}, {parts} parts: cut {cm} against rcb's {cr}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn metis_is_deterministic_across_threads_and_calls() {
+        let d = torus_ddg();
+        let h = |_p: P3| 0.05;
+        let w = tet_weights(&d, &h);
+        let one = rayon_pool(1).install(|| metis_kway(&d, &w, &h, 8));
+        let two = rayon_pool(2).install(|| metis_kway(&d, &w, &h, 8));
+        // Calls from several threads at once are serialised.
+        let many: Vec<Vec<u32>> = std::thread::scope(|s| {
+            let hs: Vec<_> = (0..4)
+                .map(|_| s.spawn(|| metis_kway(&d, &w, &h, 8)))
+                .collect();
+            hs.into_iter().map(|j| j.join().unwrap()).collect()
+        });
+        assert_eq!(one, two);
+        for m in many {
+            assert_eq!(one, m);
+        }
+    }
+
+    fn rayon_pool(n: usize) -> rayon::ThreadPool {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build()
+            .unwrap()
+    }
+
+    #[test]
+    fn partition_picks_the_method() {
+        let d = sphere_ddg();
+        let h = |_p: P3| 0.05;
+        let w = tet_weights(&d, &h);
+        assert_eq!(partition(&d, &w, &h, 4, Partition::Rcb), rcb(&d, &w, 4));
+        assert_eq!(
+            partition(&d, &w, &h, 4, Partition::Metis),
+            metis_kway(&d, &w, &h, 4)
+        );
+        assert_eq!("metis".parse::<Partition>(), Ok(Partition::Metis));
+        assert_eq!("rcb".parse::<Partition>(), Ok(Partition::Rcb));
+        assert!("x".parse::<Partition>().is_err());
+        // One part, or fewer tets than parts: no METIS call.
+        assert!(partition(&d, &w, &h, 1, Partition::Metis)
+            .iter()
+            .all(|&k| k == 0));
+    }
+
+    #[test]
+    fn the_dual_graph_is_symmetric() {
+        let d = sphere_ddg();
+        let (xadj, adj) = dual_graph(&d);
+        assert_eq!(xadj.len(), d.tets.len() + 1);
+        for t in 0..d.tets.len() {
+            for &u in &adj[xadj[t] as usize..xadj[t + 1] as usize] {
+                let back = &adj[xadj[u as usize] as usize..xadj[u as usize + 1] as usize];
+                assert!(back.contains(&(t as i32)));
+            }
+        }
+    }
+
+    #[test]
+    fn shifts_work_on_the_metis_partition() {
+        let d = torus_ddg();
+        let h = |_p: P3| 0.05;
+        let w = tet_weights(&d, &h);
+        let part = metis_kway(&d, &w, &h, 8);
+        for layers in [1, 2] {
+            let up = shifted(&d, &part, Shift::FromHigher, layers);
+            let down = shifted(&d, &part, Shift::FromLower, layers);
+            assert!(up.iter().zip(&part).any(|(a, b)| a != b));
+            assert!(down.iter().zip(&part).any(|(a, b)| a != b));
+            assert!(up.iter().zip(&part).all(|(a, b)| a <= b));
+            assert!(down.iter().zip(&part).all(|(a, b)| a >= b));
+            // Every wall moves: no DDG face keeps both sides it had.
+            let walls = |p: &[u32]| {
+                let mut v = Vec::new();
+                for t in 0..d.tets.len() {
+                    for f in 0..4 {
+                        let n = d.neigh[4 * t + f];
+                        if n != u32::MAX && ((n / 4) as usize) > t && p[(n / 4) as usize] != p[t] {
+                            v.push((t, f));
+                        }
+                    }
+                }
+                v
+            };
+            let w0 = walls(&part);
+            let w2 = walls(&up);
+            let kept = w0.iter().filter(|x| w2.binary_search(x).is_ok()).count();
+            assert_eq!(kept, 0, "{layers} layers: {kept} walls stayed in pass 2");
+        }
+    }
+
     #[test]
     fn a_shift_moves_tets_toward_the_lower_part_only() {
         let d = sphere_ddg();

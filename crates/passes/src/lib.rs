@@ -10,6 +10,7 @@
 
 mod redistribute;
 
+pub use parafront_ddg::Partition;
 pub use redistribute::Piece;
 
 use parafront_comm::Comm;
