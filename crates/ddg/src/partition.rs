@@ -233,12 +233,12 @@ pub fn metis_kway(d: &Ddg, w: &[f64], h: &(dyn Fn(P3) -> f64 + Sync), parts: usi
     let mut part = vec![0i32; n];
     let res = {
         let _one = METIS.lock().unwrap_or_else(|e| e.into_inner());
-        metis::Graph::new(1, parts as i32, &xadj, &adj).and_then(|g| {
-            Ok(g.set_vwgt(&vwgt)
+        metis::Graph::new(1, parts as i32, &xadj, &adj).map(|g| {
+            g.set_vwgt(&vwgt)
                 .set_adjwgt(&adjwgt)
                 .set_option(metis::option::Seed(1))
                 .set_option(metis::option::Contig(contig))
-                .part_kway(&mut part))
+                .part_kway(&mut part)
         })
     };
     match res {
