@@ -163,6 +163,11 @@ fn fine_faces(d: &Ddg, h: &(dyn Fn(P3) -> f64 + Sync), t: usize, f: usize) -> f6
     area / (0.25 * 3f64.sqrt() * s * s)
 }
 
+/// METIS's load tolerance in thousandths: 1.01 (its default, 1.03, gave
+/// 1.013-1.03 on sphere_1e5 at P = 8 and 32; this gives 1.000-1.001 there
+/// for about 2 % more cut faces).
+const UFACTOR: i32 = 10;
+
 /// METIS keeps its random state in a global: one call at a time, so that
 /// the same input gives the same partition whatever else runs.
 static METIS: Mutex<()> = Mutex::new(());
@@ -238,6 +243,7 @@ pub fn metis_kway(d: &Ddg, w: &[f64], h: &(dyn Fn(P3) -> f64 + Sync), parts: usi
                 .set_adjwgt(&adjwgt)
                 .set_option(metis::option::Seed(1))
                 .set_option(metis::option::Contig(contig))
+                .set_option(metis::option::UFactor(UFACTOR))
                 .part_kway(&mut part)
         })
     };
@@ -408,9 +414,9 @@ mod tests {
                 let r = rcb(&d, &w, parts);
                 assert!(m.iter().all(|&k| (k as usize) < parts));
                 let imb = imbalance(&m, &w, parts);
-                // METIS's default tolerance is 3 %; whole DDG tets add a
+                // The tolerance asked of METIS is 1 %; whole DDG tets add a
                 // little on these small grids.
-                assert!(imb < 1.06, "{name}, {parts} parts: imbalance {imb}");
+                assert!(imb < 1.02, "{name}, {parts} parts: imbalance {imb}");
                 let pieces = components(&d, &m, parts);
                 assert!(
                     pieces.iter().all(|&c| c == 1),

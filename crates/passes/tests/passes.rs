@@ -192,7 +192,7 @@ fn metis_and_rcb_partitions_on_a_torus() {
         assert!(dev < 0.05, "{method:?}: {} tets, serial {n1}", o.tets.len());
         let bound = match method {
             Partition::Rcb => 1.02,
-            Partition::Metis => 1.05,
+            Partition::Metis => 1.02,
         };
         assert!(
             st.predicted_imbalance < bound,
