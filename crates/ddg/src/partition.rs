@@ -8,6 +8,7 @@
 //! fewer faces and keeps each part connected.
 use crate::Ddg;
 use parafront_geom::{cross, norm, sub, tet_volume6, Aabb, P3};
+use rayon::prelude::*;
 use std::sync::Mutex;
 
 /// Fine tets each DDG tet will hold (§6): its volume over the volume of a
@@ -196,31 +197,28 @@ pub fn metis_kway(d: &Ddg, w: &[f64], h: &(dyn Fn(P3) -> f64 + Sync), parts: usi
         .iter()
         .map(|&x| ((x * scale).round() as i64).clamp(1, 1 << 28) as i32)
         .collect();
-    let mut ew = Vec::with_capacity(adj.len());
-    for t in 0..n {
-        for f in 0..4 {
-            if d.neigh[4 * t + f] != u32::MAX {
-                ew.push(fine_faces(d, h, t, f));
+    // Each face's weight once (from its lower tet), in parallel: the
+    // size field is the costly part of building the graph.
+    let fw: Vec<[f64; 4]> = (0..n)
+        .into_par_iter()
+        .map(|t| {
+            let mut x = [0.0; 4];
+            for (f, xf) in x.iter_mut().enumerate() {
+                let nb = d.neigh[4 * t + f];
+                if nb != u32::MAX && (nb / 4) as usize > t {
+                    *xf = fine_faces(d, h, t, f);
+                }
             }
-        }
-    }
-    // A face seen from both sides can differ in the last bit of its
-    // centroid: take the larger of the two so the graph is symmetric.
-    let mut k = 0;
+            x
+        })
+        .collect();
+    let mut ew = Vec::with_capacity(adj.len());
     for t in 0..n {
         for f in 0..4 {
             let nb = d.neigh[4 * t + f];
             if nb != u32::MAX {
                 let (u, g) = ((nb / 4) as usize, (nb % 4) as usize);
-                if u > t {
-                    // Position of the edge u -> t in u's list.
-                    let before = (0..g).filter(|&i| d.neigh[4 * u + i] != u32::MAX).count();
-                    let j = xadj[u] as usize + before;
-                    let m = ew[k].max(ew[j]);
-                    ew[k] = m;
-                    ew[j] = m;
-                }
-                k += 1;
+                ew.push(if u > t { fw[t][f] } else { fw[u][g] });
             }
         }
     }
