@@ -154,6 +154,8 @@ pub fn run_bench(
     );
     let mut base: Option<f64> = None;
     for &p in parts {
+        // P = 1 is the serial front: no partition, one row.
+        let methods = if p > 1 { methods } else { &methods[..1] };
         for &method in methods {
             for &t in threads {
                 let pool = rayon::ThreadPoolBuilder::new()
