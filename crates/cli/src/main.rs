@@ -80,6 +80,9 @@ enum Cmd {
         /// Thread counts to run, comma separated.
         #[arg(long, value_delimiter = ',', default_value = "1,2")]
         threads: Vec<usize>,
+        /// DDG partition methods to run, comma separated (metis, rcb).
+        #[arg(long, value_delimiter = ',', default_value = "metis")]
+        partition: Vec<parafront_pipeline::Partition>,
     },
     /// Convert a tet mesh between formats (.vtu, .msh, .mesh).
     Convert {
@@ -117,6 +120,11 @@ struct MeshArgs {
     /// Growth factor of the domain-defining grid (§5).
     #[arg(long)]
     ddg_growth: Option<f64>,
+    /// How the domain-defining grid is split into parts (§6): metis
+    /// (k-way on its dual graph, parts connected) or rcb (coordinate
+    /// bisection).
+    #[arg(long, default_value = "metis")]
+    partition: parafront_pipeline::Partition,
     /// With --parts > 1, also write the partitioned mesh: this .pvtu and
     /// one .vtu per part beside it.
     #[arg(long)]
@@ -194,7 +202,8 @@ fn main() -> ExitCode {
             size,
             parts,
             threads,
-        } => parallel::run_bench(&surface, size, &parts, &threads),
+            partition,
+        } => parallel::run_bench(&surface, size, &parts, &threads, &partition),
         Cmd::Quality { mesh, plot, before } => {
             run_quality(&mesh, plot.as_deref(), before.as_deref())
         }
@@ -255,6 +264,7 @@ fn mesh_options(a: &MeshArgs) -> Result<MeshOptions, Fail> {
     }
     o.parts = a.parts;
     o.ddg_growth = a.ddg_growth.unwrap_or(0.0);
+    o.partition = a.partition;
     if a.pvtu.is_some() && o.optimize > 0 {
         // The pieces are the generation's partition (§8); improvement
         // (§9) changes the mesh after it and does not renumber them yet.

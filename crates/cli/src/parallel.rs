@@ -23,6 +23,14 @@ pub fn print_parallel(sum: &Summary) {
             st.ddg_seconds
         );
         println!(
+            "  partition {}: {} DDG faces between parts (about {:.0} fine faces), most pieces in one part {}, split {:.3} s",
+            st.partition.name(),
+            st.cut_faces,
+            st.cut_fine_faces,
+            st.max_components,
+            st.split_seconds
+        );
+        println!(
             "  imbalance (max/mean): predicted {:.3}, made in passes 1-3 {:.3}, held after redistribution {:.3}",
             st.predicted_imbalance, st.made_imbalance, st.held_imbalance
         );
@@ -128,6 +136,7 @@ pub fn run_bench(
     size: Option<f64>,
     parts: &[usize],
     threads: &[usize],
+    methods: &[parafront_pipeline::Partition],
 ) -> Result<(), Fail> {
     let s = parafront_surface::read::read_surface(path)?;
     println!(
@@ -137,81 +146,95 @@ pub fn run_bench(
         s.tris.len()
     );
     println!(
-        "{:>5} {:>5} {:>5} {:>9} {:>9} {:>11} {:>11} | {:>7} {:>7} {:>7} {:>7} {:>7} {:>7} | {:>6} {:>6} {:>6} {:>6} | {:>6} {:>6} {:>8}",
+        "{:>5} {:>5} {:>5} {:>9} {:>9} {:>11} {:>11} | {:>7} {:>7} {:>7} {:>7} {:>7} {:>7} | {:>6} {:>6} {:>6} {:>6} | {:>6} {:>6} {:>8} | {:>5} {:>6} {:>8} {:>4} {:>7}",
         "nproc", "nprol", "ncore", "nelem", "CPU s", "AbsSpeed", "RelSpeed",
         "ddg", "part", "pass1", "pass2", "pass3", "pass4",
-        "%p1", "%p2", "%p3", "%p4", "imbP", "imbH", "crit s"
+        "%p1", "%p2", "%p3", "%p4", "imbP", "imbH", "crit s",
+        "split", "cut", "cutF", "pcs", "split s"
     );
     let mut base: Option<f64> = None;
     for &p in parts {
-        for &t in threads {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(t.max(1))
-                .build()
-                .map_err(|e| Fail(2, e.to_string()))?;
-            // Generation only, as in the paper's tables: no improvement.
-            let mut o = parafront_pipeline::MeshOptions {
-                parts: p.max(1),
-                threads: t,
-                optimize: 0,
-                ..Default::default()
-            };
-            o.size.h = size;
-            let t0 = std::time::Instant::now();
-            let (m, sum) = pool
-                .install(|| parafront_pipeline::mesh_surface(&s, &o))
-                .map_err(|e| Fail(1, format!("parts {p}, threads {t}: {e}")))?;
-            let secs = t0.elapsed().as_secs_f64();
-            let n = m.tets.len();
-            let cores = t.max(1);
-            let nprol = (cores / p.max(1)).max(1);
-            let st = sum.parallel.first();
-            let share = |k: usize| {
-                st.map_or(if k == 0 { 100.0 } else { 0.0 }, |_| {
-                    let tot: usize = sum
-                        .parallel
-                        .iter()
-                        .map(|x| x.pass_tets.iter().sum::<usize>())
-                        .sum();
-                    100.0 * sum.parallel.iter().map(|x| x.pass_tets[k]).sum::<usize>() as f64
-                        / tot.max(1) as f64
-                })
-            };
-            let crit: f64 = if sum.parallel.is_empty() {
-                secs
-            } else {
-                sum.total_seconds()
-                    - sum
-                        .parallel
-                        .iter()
-                        .map(|x| x.pass_seconds[..3].iter().sum::<f64>())
-                        .sum::<f64>()
-                    + sum
-                        .parallel
-                        .iter()
-                        .map(|x| {
-                            x.part_seconds
-                                .iter()
-                                .map(|v| v.iter().cloned().fold(0.0, f64::max))
-                                .sum::<f64>()
-                        })
-                        .sum::<f64>()
-            };
-            base.get_or_insert(secs);
-            println!(
-                "{:>5} {:>5} {:>5} {:>9} {:>9.2} {:>11.0} {:>11.0} | {:>7.2} {:>7.2} {:>7.2} {:>7.2} {:>7.2} {:>7.2} | {:>6.2} {:>6.2} {:>6.2} {:>6.2} | {:>6.3} {:>6.3} {:>8.2}",
+        // P = 1 is the serial front: no partition, one row.
+        let methods = if p > 1 { methods } else { &methods[..1] };
+        for &method in methods {
+            for &t in threads {
+                let pool = rayon::ThreadPoolBuilder::new()
+                    .num_threads(t.max(1))
+                    .build()
+                    .map_err(|e| Fail(2, e.to_string()))?;
+                // Generation only, as in the paper's tables: no improvement.
+                let mut o = parafront_pipeline::MeshOptions {
+                    parts: p.max(1),
+                    threads: t,
+                    optimize: 0,
+                    partition: method,
+                    ..Default::default()
+                };
+                o.size.h = size;
+                let t0 = std::time::Instant::now();
+                let (m, sum) = pool
+                    .install(|| parafront_pipeline::mesh_surface(&s, &o))
+                    .map_err(|e| Fail(1, format!("parts {p}, threads {t}: {e}")))?;
+                let secs = t0.elapsed().as_secs_f64();
+                let n = m.tets.len();
+                let cores = t.max(1);
+                let nprol = (cores / p.max(1)).max(1);
+                let st = sum.parallel.first();
+                let share = |k: usize| {
+                    st.map_or(if k == 0 { 100.0 } else { 0.0 }, |_| {
+                        let tot: usize = sum
+                            .parallel
+                            .iter()
+                            .map(|x| x.pass_tets.iter().sum::<usize>())
+                            .sum();
+                        100.0 * sum.parallel.iter().map(|x| x.pass_tets[k]).sum::<usize>() as f64
+                            / tot.max(1) as f64
+                    })
+                };
+                let crit: f64 = if sum.parallel.is_empty() {
+                    secs
+                } else {
+                    sum.total_seconds()
+                        - sum
+                            .parallel
+                            .iter()
+                            .map(|x| x.pass_seconds[..3].iter().sum::<f64>())
+                            .sum::<f64>()
+                        + sum
+                            .parallel
+                            .iter()
+                            .map(|x| {
+                                x.part_seconds
+                                    .iter()
+                                    .map(|v| v.iter().cloned().fold(0.0, f64::max))
+                                    .sum::<f64>()
+                            })
+                            .sum::<f64>()
+                };
+                base.get_or_insert(secs);
+                println!(
+                "{:>5} {:>5} {:>5} {:>9} {:>9.2} {:>11.0} {:>11.0} | {:>7.2} {:>7.2} {:>7.2} {:>7.2} {:>7.2} {:>7.2} | {:>6.2} {:>6.2} {:>6.2} {:>6.2} | {:>6.3} {:>6.3} {:>8.2} | {:>5} {:>6} {:>8.0} {:>4} {:>7.3}",
                 p, nprol, cores, n, secs, n as f64 / secs, n as f64 / secs / cores as f64,
                 sum.seconds("ddg") + 0.0, sum.seconds("partition") + 0.0,
                 if p > 1 { sum.seconds("pass 1") } else { sum.seconds("front") } + 0.0,
                 sum.seconds("pass 2") + 0.0, sum.seconds("pass 3") + 0.0, sum.seconds("pass 4") + 0.0,
                 share(0), share(1), share(2), share(3),
                 st.map_or(1.0, |x| x.predicted_imbalance), st.map_or(1.0, |x| x.held_imbalance),
-                crit
+                crit,
+                st.map_or("-", |x| x.partition.name()),
+                st.map_or(0, |x| x.cut_faces),
+                st.map_or(0.0, |x| x.cut_fine_faces),
+                st.map_or(1, |x| x.max_components),
+                st.map_or(0.0, |x| x.split_seconds)
             );
+            }
         }
     }
     println!(
         "imbP: predicted (DDG weights), imbH: tets held after redistribution (max/mean, region 1);"
+    );
+    println!(
+        "split: DDG partition; cut: DDG faces between parts (cutF: the fine faces expected on them); pcs: most face-connected pieces of one part; split s: its seconds (region 1)."
     );
     println!(
         "crit s: the run with each parallel pass timed by its slowest part (one core per part)."

@@ -8,7 +8,10 @@ mod locate;
 mod partition;
 
 pub use locate::{Interfaces, Locator, PartFilter};
-pub use partition::{imbalance, rcb, shifted, tet_weights, Shift};
+pub use partition::{
+    components, cut_faces, cut_fine_faces, dual_graph, imbalance, metis_kway, partition, rcb,
+    shifted, tet_weights, Partition, Shift,
+};
 
 use parafront_front::{advance, Everywhere, FrontError, FrontInput, FrontOptions, SizeMode};
 use parafront_geom::P3;

@@ -1,7 +1,15 @@
 //! Weights and the balanced split of the DDG (§6, step 2), and the shifted
 //! partitions of passes 2 and 3 (§7).
+//!
+//! Two splits: recursive coordinate bisection ([`rcb`]) and METIS's
+//! multilevel k-way partition of the DDG's dual graph ([`metis_kway`]:
+//! tets as vertices weighted by the fine tets they will hold, shared faces
+//! as edges weighted by the fine faces that will cross them), which cuts
+//! fewer faces and keeps each part connected.
 use crate::Ddg;
-use parafront_geom::{tet_volume6, Aabb, P3};
+use parafront_geom::{cross, norm, sub, tet_volume6, Aabb, P3};
+use rayon::prelude::*;
+use std::sync::Mutex;
 
 /// Fine tets each DDG tet will hold (§6): its volume over the volume of a
 /// regular tet at the size `h` at its centroid.
@@ -70,6 +78,240 @@ fn split(cen: &[P3], w: &[f64], ids: &mut [u32], first: u32, parts: u32, part: &
     let (a, b) = ids.split_at_mut(cut);
     split(cen, w, a, first, left, part);
     split(cen, w, b, first + left, parts - left, part);
+}
+
+/// How the DDG is split into parts (§6, step 2).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Partition {
+    /// Recursive coordinate bisection of the tets' centroids by weight.
+    Rcb,
+    /// METIS k-way on the dual graph, parts kept connected.
+    #[default]
+    Metis,
+}
+
+impl Partition {
+    pub fn name(self) -> &'static str {
+        match self {
+            Partition::Rcb => "rcb",
+            Partition::Metis => "metis",
+        }
+    }
+}
+
+impl std::str::FromStr for Partition {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "rcb" => Ok(Partition::Rcb),
+            "metis" => Ok(Partition::Metis),
+            _ => Err(format!("unknown partition method {s:?} (rcb or metis)")),
+        }
+    }
+}
+
+/// Splits the DDG into `parts` parts of about equal weight `w` by
+/// `method`; `h` is the fine size (it weights the faces METIS cuts).
+/// Deterministic: the same partition for any thread count.
+pub fn partition(
+    d: &Ddg,
+    w: &[f64],
+    h: &(dyn Fn(P3) -> f64 + Sync),
+    parts: usize,
+    method: Partition,
+) -> Vec<u32> {
+    match method {
+        Partition::Rcb => rcb(d, w, parts),
+        Partition::Metis => metis_kway(d, w, h, parts),
+    }
+}
+
+/// The DDG's dual graph in CSR form (METIS's `xadj`, `adjncy`): one vertex
+/// per tet, one edge per interior face, in tet and face order.
+pub fn dual_graph(d: &Ddg) -> (Vec<i32>, Vec<i32>) {
+    let mut xadj = Vec::with_capacity(d.tets.len() + 1);
+    let mut adj = Vec::with_capacity(4 * d.tets.len());
+    xadj.push(0);
+    for t in 0..d.tets.len() {
+        for f in 0..4 {
+            let n = d.neigh[4 * t + f];
+            if n != u32::MAX {
+                adj.push((n / 4) as i32);
+            }
+        }
+        xadj.push(adj.len() as i32);
+    }
+    (xadj, adj)
+}
+
+/// The fine faces that will cross face `f` (opposite vertex `f`) of DDG
+/// tet `t`: its area over the area of an equilateral triangle of the fine
+/// size at its centroid.
+fn fine_faces(d: &Ddg, h: &(dyn Fn(P3) -> f64 + Sync), t: usize, f: usize) -> f64 {
+    let tv = d.tets[t];
+    let mut v = [[0.0; 3]; 3];
+    let mut k = 0;
+    for (i, &p) in tv.iter().enumerate() {
+        if i != f {
+            v[k] = d.points[p as usize];
+            k += 1;
+        }
+    }
+    let area = 0.5 * norm(cross(sub(v[1], v[0]), sub(v[2], v[0])));
+    let c = [0, 1, 2].map(|i| (v[0][i] + v[1][i] + v[2][i]) / 3.0);
+    let s = h(c);
+    area / (0.25 * 3f64.sqrt() * s * s)
+}
+
+/// METIS's load tolerance in thousandths: 1.01 (its default, 1.03, gave
+/// 1.013-1.03 on sphere_1e5 at P = 8 and 32; this gives 1.000-1.001 there
+/// for about 2 % more cut faces).
+const UFACTOR: i32 = 10;
+
+/// METIS keeps its random state in a global: one call at a time, so that
+/// the same input gives the same partition whatever else runs.
+static METIS: Mutex<()> = Mutex::new(());
+
+/// METIS k-way partition of the dual graph (§6 with a graph refinement:
+/// METIS coarsens, splits and refines with FM, lowering the cut). Vertex
+/// weights are `w` scaled to integers, edge weights the fine faces across
+/// each DDG face; a fixed seed and one call at a time make it
+/// deterministic. Each part is kept connected when the DDG is (METIS's
+/// `CONTIG`); on any METIS error it falls back to [`rcb`].
+pub fn metis_kway(d: &Ddg, w: &[f64], h: &(dyn Fn(P3) -> f64 + Sync), parts: usize) -> Vec<u32> {
+    let n = d.tets.len();
+    if parts <= 1 || n <= parts {
+        return rcb(d, w, parts);
+    }
+    let (xadj, adj) = dual_graph(d);
+    // Integer weights: the total scaled to about 2^26 (room in METIS's
+    // 32-bit sums), every tet at least 1.
+    let total: f64 = w.iter().sum();
+    let scale = if total > 0.0 {
+        (1u64 << 26) as f64 / total
+    } else {
+        1.0
+    };
+    let vwgt: Vec<i32> = w
+        .iter()
+        .map(|&x| ((x * scale).round() as i64).clamp(1, 1 << 28) as i32)
+        .collect();
+    // Each face's weight once (from its lower tet), in parallel: the
+    // size field is the costly part of building the graph.
+    let fw: Vec<[f64; 4]> = (0..n)
+        .into_par_iter()
+        .map(|t| {
+            let mut x = [0.0; 4];
+            for (f, xf) in x.iter_mut().enumerate() {
+                let nb = d.neigh[4 * t + f];
+                if nb != u32::MAX && (nb / 4) as usize > t {
+                    *xf = fine_faces(d, h, t, f);
+                }
+            }
+            x
+        })
+        .collect();
+    let mut ew = Vec::with_capacity(adj.len());
+    for t in 0..n {
+        for f in 0..4 {
+            let nb = d.neigh[4 * t + f];
+            if nb != u32::MAX {
+                let (u, g) = ((nb / 4) as usize, (nb % 4) as usize);
+                ew.push(if u > t { fw[t][f] } else { fw[u][g] });
+            }
+        }
+    }
+    let etot: f64 = ew.iter().sum();
+    let escale = if etot > (1u64 << 29) as f64 {
+        (1u64 << 29) as f64 / etot
+    } else {
+        1.0
+    };
+    let adjwgt: Vec<i32> = ew
+        .iter()
+        .map(|&x| ((x * escale).round() as i64).clamp(1, 1 << 28) as i32)
+        .collect();
+    let contig = components(d, &vec![0u32; n], 1)[0] == 1;
+    let mut part = vec![0i32; n];
+    let res = {
+        let _one = METIS.lock().unwrap_or_else(|e| e.into_inner());
+        metis::Graph::new(1, parts as i32, &xadj, &adj).map(|g| {
+            g.set_vwgt(&vwgt)
+                .set_adjwgt(&adjwgt)
+                .set_option(metis::option::Seed(1))
+                .set_option(metis::option::Contig(contig))
+                .set_option(metis::option::UFactor(UFACTOR))
+                .part_kway(&mut part)
+        })
+    };
+    match res {
+        Ok(Ok(_cut)) if part.iter().all(|&k| k >= 0 && (k as usize) < parts) => {
+            part.iter().map(|&k| k as u32).collect()
+        }
+        _ => rcb(d, w, parts),
+    }
+}
+
+/// DDG faces between tets of different parts (the cut of the dual graph).
+pub fn cut_faces(d: &Ddg, part: &[u32]) -> usize {
+    let mut cut = 0;
+    for t in 0..d.tets.len() {
+        for f in 0..4 {
+            let n = d.neigh[4 * t + f];
+            if n != u32::MAX && ((n / 4) as usize) > t && part[(n / 4) as usize] != part[t] {
+                cut += 1;
+            }
+        }
+    }
+    cut
+}
+
+/// The fine faces that will lie on the walls between parts: the cut
+/// faces weighted by their area over the fine size squared.
+pub fn cut_fine_faces(d: &Ddg, part: &[u32], h: &(dyn Fn(P3) -> f64 + Sync)) -> f64 {
+    let mut cut = 0.0;
+    for t in 0..d.tets.len() {
+        for f in 0..4 {
+            let n = d.neigh[4 * t + f];
+            if n != u32::MAX && ((n / 4) as usize) > t && part[(n / 4) as usize] != part[t] {
+                cut += fine_faces(d, h, t, f);
+            }
+        }
+    }
+    cut
+}
+
+/// Per part, how many face-connected pieces its tets make (1 for a
+/// connected part, 0 for an empty one).
+pub fn components(d: &Ddg, part: &[u32], parts: usize) -> Vec<usize> {
+    let n = d.tets.len();
+    let mut seen = vec![false; n];
+    let mut count = vec![0usize; parts];
+    let mut stack = Vec::new();
+    for s in 0..n {
+        if seen[s] {
+            continue;
+        }
+        let k = part[s];
+        count[k as usize] += 1;
+        seen[s] = true;
+        stack.push(s);
+        while let Some(t) = stack.pop() {
+            for f in 0..4 {
+                let nb = d.neigh[4 * t + f];
+                if nb == u32::MAX {
+                    continue;
+                }
+                let u = (nb / 4) as usize;
+                if !seen[u] && part[u] == k {
+                    seen[u] = true;
+                    stack.push(u);
+                }
+            }
+        }
+    }
+    count
 }
 
 /// Which way passes 2 and 3 move the walls (§7).
@@ -143,6 +385,146 @@ mod tests {
             }
             let imb = imbalance(&part, &w, parts);
             assert!(imb < 1.15, "{parts} parts: imbalance {imb}");
+        }
+    }
+
+    fn torus_ddg() -> Ddg {
+        let s = generate::torus([0.0; 3], 1.0, 0.4, 48, 20);
+        let faces: Vec<[u32; 3]> = s.tris.iter().map(|t| [t[0], t[2], t[1]]).collect();
+        crate::build(
+            s.points.clone(),
+            s.mean_edge_lengths(),
+            faces,
+            crate::DEFAULT_GROWTH,
+            crate::DdgMode::default(),
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn metis_balances_connects_and_cuts_less_than_rcb() {
+        // The fine size: finer on one side, so the weights vary.
+        let h = |p: P3| 0.04 + 0.02 * (p[0] + 1.5);
+        for (name, d) in [("sphere", sphere_ddg()), ("torus", torus_ddg())] {
+            let w = tet_weights(&d, &h);
+            for parts in [2usize, 3, 8, 16] {
+                let m = metis_kway(&d, &w, &h, parts);
+                let r = rcb(&d, &w, parts);
+                assert!(m.iter().all(|&k| (k as usize) < parts));
+                let imb = imbalance(&m, &w, parts);
+                // The tolerance asked of METIS is 1 %; whole DDG tets add a
+                // little on these small grids.
+                assert!(imb < 1.02, "{name}, {parts} parts: imbalance {imb}");
+                let pieces = components(&d, &m, parts);
+                assert!(
+                    pieces.iter().all(|&c| c == 1),
+                    "{name}, {parts} parts: pieces per part {pieces:?}"
+                );
+                let (cm, cr) = (cut_fine_faces(&d, &m, &h), cut_fine_faces(&d, &r, &h));
+                let (fm, fr) = (cut_faces(&d, &m), cut_faces(&d, &r));
+                eprintln!(
+                    "{name}, {parts} parts, {} DDG tets: imbalance metis {imb:.3} rcb {:.3}; cut fine faces metis {cm:.0} rcb {cr:.0}; DDG faces {fm} / {fr}; rcb pieces {:?}",
+                    d.tets.len(),
+                    imbalance(&r, &w, parts),
+                    components(&d, &r, parts)
+                );
+                assert!(
+                    cm < cr,
+                    "{name}, {parts} parts: cut {cm} against rcb's {cr}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn metis_is_deterministic_across_threads_and_calls() {
+        let d = torus_ddg();
+        let h = |_p: P3| 0.05;
+        let w = tet_weights(&d, &h);
+        let one = rayon_pool(1).install(|| metis_kway(&d, &w, &h, 8));
+        let two = rayon_pool(2).install(|| metis_kway(&d, &w, &h, 8));
+        // Calls from several threads at once are serialised.
+        let many: Vec<Vec<u32>> = std::thread::scope(|s| {
+            let hs: Vec<_> = (0..4)
+                .map(|_| s.spawn(|| metis_kway(&d, &w, &h, 8)))
+                .collect();
+            hs.into_iter().map(|j| j.join().unwrap()).collect()
+        });
+        assert_eq!(one, two);
+        for m in many {
+            assert_eq!(one, m);
+        }
+    }
+
+    fn rayon_pool(n: usize) -> rayon::ThreadPool {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build()
+            .unwrap()
+    }
+
+    #[test]
+    fn partition_picks_the_method() {
+        let d = sphere_ddg();
+        let h = |_p: P3| 0.05;
+        let w = tet_weights(&d, &h);
+        assert_eq!(partition(&d, &w, &h, 4, Partition::Rcb), rcb(&d, &w, 4));
+        assert_eq!(
+            partition(&d, &w, &h, 4, Partition::Metis),
+            metis_kway(&d, &w, &h, 4)
+        );
+        assert_eq!("metis".parse::<Partition>(), Ok(Partition::Metis));
+        assert_eq!("rcb".parse::<Partition>(), Ok(Partition::Rcb));
+        assert!("x".parse::<Partition>().is_err());
+        // One part, or fewer tets than parts: no METIS call.
+        assert!(partition(&d, &w, &h, 1, Partition::Metis)
+            .iter()
+            .all(|&k| k == 0));
+    }
+
+    #[test]
+    fn the_dual_graph_is_symmetric() {
+        let d = sphere_ddg();
+        let (xadj, adj) = dual_graph(&d);
+        assert_eq!(xadj.len(), d.tets.len() + 1);
+        for t in 0..d.tets.len() {
+            for &u in &adj[xadj[t] as usize..xadj[t + 1] as usize] {
+                let back = &adj[xadj[u as usize] as usize..xadj[u as usize + 1] as usize];
+                assert!(back.contains(&(t as i32)));
+            }
+        }
+    }
+
+    #[test]
+    fn shifts_work_on_the_metis_partition() {
+        let d = torus_ddg();
+        let h = |_p: P3| 0.05;
+        let w = tet_weights(&d, &h);
+        let part = metis_kway(&d, &w, &h, 8);
+        for layers in [1, 2] {
+            let up = shifted(&d, &part, Shift::FromHigher, layers);
+            let down = shifted(&d, &part, Shift::FromLower, layers);
+            assert!(up.iter().zip(&part).any(|(a, b)| a != b));
+            assert!(down.iter().zip(&part).any(|(a, b)| a != b));
+            assert!(up.iter().zip(&part).all(|(a, b)| a <= b));
+            assert!(down.iter().zip(&part).all(|(a, b)| a >= b));
+            // Every wall moves: no DDG face keeps both sides it had.
+            let walls = |p: &[u32]| {
+                let mut v = Vec::new();
+                for t in 0..d.tets.len() {
+                    for f in 0..4 {
+                        let n = d.neigh[4 * t + f];
+                        if n != u32::MAX && ((n / 4) as usize) > t && p[(n / 4) as usize] != p[t] {
+                            v.push((t, f));
+                        }
+                    }
+                }
+                v
+            };
+            let w0 = walls(&part);
+            let w2 = walls(&up);
+            let kept = w0.iter().filter(|x| w2.binary_search(x).is_ok()).count();
+            assert_eq!(kept, 0, "{layers} layers: {kept} walls stayed in pass 2");
         }
     }
 

@@ -10,6 +10,7 @@
 
 mod redistribute;
 
+pub use parafront_ddg::Partition;
 pub use redistribute::Piece;
 
 use parafront_comm::Comm;
@@ -29,6 +30,8 @@ pub struct ParOptions {
     pub growth: f64,
     /// DDG layers moved across each wall in passes 2 and 3 (§7: 1 or 2).
     pub layers: usize,
+    /// How the DDG is split (§6): METIS k-way or coordinate bisection.
+    pub partition: ddg::Partition,
 }
 
 impl Default for ParOptions {
@@ -37,6 +40,7 @@ impl Default for ParOptions {
             parts: 2,
             growth: ddg::DEFAULT_GROWTH,
             layers: 2,
+            partition: ddg::Partition::default(),
         }
     }
 }
@@ -67,6 +71,15 @@ pub struct ParStats {
     pub ddg_graded: bool,
     pub ddg_seconds: f64,
     pub partition_seconds: f64,
+    /// Of which the split itself (RCB or METIS).
+    pub split_seconds: f64,
+    /// The split used, the DDG faces between parts, the fine faces
+    /// expected on them, and the face-connected pieces of the most broken
+    /// part (1: every part connected).
+    pub partition: ddg::Partition,
+    pub cut_faces: usize,
+    pub cut_fine_faces: f64,
+    pub max_components: usize,
     /// Max over mean of the predicted (DDG weight) load.
     pub predicted_imbalance: f64,
     /// Max over mean of the tets each part made in pass 1 to 3, and of the
@@ -214,11 +227,20 @@ pub fn mesh_parallel<C: Comm>(
     let t0 = Instant::now();
     let loc = Locator::new(&d);
     let w = ddg::tet_weights(&d, size);
-    let part0 = ddg::rcb(&d, &w, np);
+    let t1 = Instant::now();
+    let part0 = ddg::partition(&d, &w, size, np, opts.partition);
+    st.split_seconds = t1.elapsed().as_secs_f64();
     st.predicted_imbalance = ddg::imbalance(&part0, &w, np);
     let part2 = ddg::shifted(&d, &part0, Shift::FromHigher, opts.layers);
     let part3 = ddg::shifted(&d, &part0, Shift::FromLower, opts.layers);
     st.partition_seconds = t0.elapsed().as_secs_f64();
+    st.partition = opts.partition;
+    st.cut_faces = ddg::cut_faces(&d, &part0);
+    st.cut_fine_faces = ddg::cut_fine_faces(&d, &part0, size);
+    st.max_components = ddg::components(&d, &part0, np)
+        .into_iter()
+        .max()
+        .unwrap_or(0);
 
     // The input front starts on part 0 (the reader); pass 1 sends it out.
     let mut parts: Vec<Part> = (0..np).map(|_| Part::default()).collect();

@@ -5,6 +5,7 @@
 
 mod regions;
 
+pub use parafront_ddg::Partition;
 pub use regions::{material_regions, RegionFront};
 
 use parafront_front::{advance, FrontError, FrontInput, FrontOptions, SizeMode};
@@ -36,6 +37,9 @@ pub struct MeshOptions {
     /// DDG growth factor `c_i` (§5); 0 takes the default (1.6).
     #[serde(default)]
     pub ddg_growth: f64,
+    /// How the DDG is split into parts (§6): `metis` or `rcb`.
+    #[serde(default)]
+    pub partition: parafront_ddg::Partition,
     /// Skip the final validity check (not recommended; it is cheap).
     #[serde(default)]
     pub no_check: bool,
@@ -65,6 +69,7 @@ impl Default for MeshOptions {
             threads: 0,
             parts: 1,
             ddg_growth: 0.0,
+            partition: parafront_ddg::Partition::default(),
             no_check: false,
             debug_partial: false,
             progress: None,
@@ -300,6 +305,7 @@ fn mesh_parts(
         } else {
             parafront_ddg::DEFAULT_GROWTH
         },
+        partition: opts.partition,
         ..ParOptions::default()
     };
     let comm = parafront_comm::Threads::new(opts.parts);
