@@ -237,7 +237,7 @@ pub fn needle_plate(thickness: f64, rim: usize) -> Surface {
         _ => 1,
     };
     let mut s = Surface::default();
-    let mut layer = |z: f64, s: &mut Surface| {
+    let layer = |z: f64, s: &mut Surface| {
         let c: Vec<u32> = corners
             .iter()
             .map(|q| {
@@ -256,7 +256,7 @@ pub fn needle_plate(thickness: f64, rim: usize) -> Surface {
     };
     let (ct, ht) = layer(thickness, &mut s);
     let (cb, hb) = layer(0.0, &mut s);
-    let mut add = |t: [u32; 3], out: P3, s: &mut Surface| {
+    let add = |t: [u32; 3], out: P3, s: &mut Surface| {
         // Orient by the wanted outward direction.
         let [a, b, c] = t.map(|i| s.points[i as usize]);
         let t = if dot(tri_normal(a, b, c), out) > 0.0 {
