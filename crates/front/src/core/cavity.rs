@@ -18,12 +18,11 @@ const MAX_POCKET: usize = 400;
 const MAX_GROWTH: usize = 12;
 /// Pockets up to this many faces may be closed from their own corners.
 const MAX_EXHAUSTIVE: usize = 24;
-/// The same in late recovery rounds, before any growth.
-const MAX_EXHAUSTIVE_LATE: usize = 64;
 /// Apex checks one exhaustive search may spend.
 const EXHAUSTIVE_BUDGET: usize = 20_000;
-/// Recovery round from which small pockets try their own corners first.
-const EXHAUSTIVE_FROM_ROUND: u32 = 3;
+/// Recovery round from which pockets are coned in patches, and flat
+/// cones are allowed.
+const LATE_FROM_ROUND: u32 = 3;
 /// Cones one kernel search may place in a row.
 const MAX_KERNEL_CONES: usize = 24;
 /// Seeds and size of the patches a pocket with no kernel is coned in.
@@ -107,15 +106,6 @@ impl<'a> Front<'a> {
             if pocket.len() > MAX_POCKET || pocket.iter().any(|&f| self.prohibited_face(f)) {
                 return Pocket::Failed;
             }
-            if round == 0
-                && self.relax >= EXHAUSTIVE_FROM_ROUND
-                && pocket.len() <= MAX_EXHAUSTIVE_LATE
-                && self.close_by_existing(&pocket, EXHAUSTIVE_BUDGET)
-            {
-                // Recovery has tried the better ways already: a small pocket
-                // that its own corners can close is closed (CAD needles).
-                return Pocket::Filled;
-            }
             let p = self.kernel_point(&pocket);
             let bad: Vec<u32> = pocket
                 .iter()
@@ -164,7 +154,7 @@ impl<'a> Front<'a> {
                 "pocket"
             );
             // Late recovery: growth has had its rounds; flat cones instead.
-            let late = self.relax >= EXHAUSTIVE_FROM_ROUND;
+            let late = self.relax >= LATE_FROM_ROUND;
             if round + 1 == MAX_GROWTH
                 && self.worst_cone(&pocket, p) >= INPUT_BOUND_FLOOR
                 && self.region.point_ok(p)
