@@ -80,6 +80,9 @@ enum Cmd {
         /// Thread counts to run, comma separated.
         #[arg(long, value_delimiter = ',', default_value = "1,2")]
         threads: Vec<usize>,
+        /// Parallel passes that build the DDG (0: the serial front).
+        #[arg(long)]
+        ddg_passes: Option<usize>,
     },
     /// Convert a tet mesh between formats (.vtu, .msh, .mesh).
     Convert {
@@ -117,6 +120,10 @@ struct MeshArgs {
     /// Growth factor of the domain-defining grid (§5).
     #[arg(long)]
     ddg_growth: Option<f64>,
+    /// Parallel passes that build the DDG before a serial pass closes it
+    /// (0: the serial front builds it)
+    #[arg(long)]
+    ddg_passes: Option<usize>,
     /// With --parts > 1, also write the partitioned mesh: this .pvtu and
     /// one .vtu per part beside it.
     #[arg(long)]
@@ -194,7 +201,8 @@ fn main() -> ExitCode {
             size,
             parts,
             threads,
-        } => parallel::run_bench(&surface, size, &parts, &threads),
+            ddg_passes,
+        } => parallel::run_bench(&surface, size, &parts, &threads, ddg_passes),
         Cmd::Quality { mesh, plot, before } => {
             run_quality(&mesh, plot.as_deref(), before.as_deref())
         }
@@ -255,6 +263,7 @@ fn mesh_options(a: &MeshArgs) -> Result<MeshOptions, Fail> {
     }
     o.parts = a.parts;
     o.ddg_growth = a.ddg_growth.unwrap_or(0.0);
+    o.ddg_passes = a.ddg_passes;
     if a.pvtu.is_some() && o.optimize > 0 {
         // The pieces are the generation's partition (§8); improvement
         // (§9) changes the mesh after it and does not renumber them yet.

@@ -128,6 +128,7 @@ pub fn run_bench(
     size: Option<f64>,
     parts: &[usize],
     threads: &[usize],
+    ddg_passes: Option<usize>,
 ) -> Result<(), Fail> {
     let s = parafront_surface::read::read_surface(path)?;
     println!(
@@ -154,6 +155,7 @@ pub fn run_bench(
                 parts: p.max(1),
                 threads: t,
                 optimize: 0,
+                ddg_passes,
                 ..Default::default()
             };
             o.size.h = size;

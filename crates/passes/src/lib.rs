@@ -8,13 +8,17 @@
 //! this module and only ever touched by the closure of its own part); parts
 //! see each other's data only through the messages of a [`Comm`].
 
+mod ddg_build;
 mod redistribute;
 
+pub use ddg_build::{build_ddg, DdgBuildStats};
 pub use redistribute::Piece;
 
 use parafront_comm::Comm;
 use parafront_ddg::{self as ddg, Ddg, Interfaces, Locator, PartFilter, Shift};
-use parafront_front::{advance, Everywhere, FrontError, FrontInput, FrontOptions, SizeMode};
+use parafront_front::{
+    advance, Everywhere, FrontError, FrontInput, FrontOptions, RegionFilter, SizeMode,
+};
 use parafront_geom::{Aabb, P3};
 use rayon::prelude::*;
 use rustc_hash::FxHashMap;
@@ -29,7 +33,14 @@ pub struct ParOptions {
     pub growth: f64,
     /// DDG layers moved across each wall in passes 2 and 3 (§7: 1 or 2).
     pub layers: usize,
+    /// Parallel passes that build the DDG (on convex cells, then a serial
+    /// pass on what they leave: [`build_ddg`]); 0 builds it with the
+    /// serial front.
+    pub ddg_passes: usize,
 }
+
+/// Parallel passes of the DDG's build by default.
+pub const DEFAULT_DDG_PASSES: usize = 2;
 
 impl Default for ParOptions {
     fn default() -> Self {
@@ -37,6 +48,7 @@ impl Default for ParOptions {
             parts: 2,
             growth: ddg::DEFAULT_GROWTH,
             layers: 2,
+            ddg_passes: DEFAULT_DDG_PASSES,
         }
     }
 }
@@ -66,6 +78,8 @@ pub struct ParStats {
     /// The DDG used the graded field (the per-face growth got stuck).
     pub ddg_graded: bool,
     pub ddg_seconds: f64,
+    /// With a DDG built by passes: what each pass made.
+    pub ddg_build: Option<DdgBuildStats>,
     pub partition_seconds: f64,
     /// Max over mean of the predicted (DDG weight) load.
     pub predicted_imbalance: f64,
@@ -178,6 +192,51 @@ struct Made {
     seconds: f64,
 }
 
+/// Where the parts may mesh in one pass (§7): a conservative owner for
+/// each point, a box around each part's region (every front face meeting
+/// it goes to the part as context) and the region filter of a part. The
+/// passes of the fine mesh take their regions from the DDG; the passes
+/// that build the DDG itself, before any DDG exists, take convex cells.
+pub(crate) trait Regions: Sync {
+    /// `Some(k)` when `p` lies inside part `k`'s region, off its walls.
+    fn owner(&self, p: P3) -> Option<u32>;
+    /// Per part, a box around its region.
+    fn bounds(&self) -> Vec<Aabb>;
+    /// The region filter of part `k`.
+    fn filter(&self, k: u32) -> Box<dyn RegionFilter + '_>;
+}
+
+/// The regions of one DDG partition.
+struct DdgRegions<'a> {
+    d: &'a Ddg,
+    loc: &'a Locator,
+    walls: Interfaces,
+    part_of: &'a [u32],
+}
+
+impl Regions for DdgRegions<'_> {
+    fn owner(&self, p: P3) -> Option<u32> {
+        self.loc.owner(p, self.part_of)
+    }
+    fn bounds(&self) -> Vec<Aabb> {
+        let np = self.part_of.iter().map(|&k| k as usize + 1).max().unwrap_or(0);
+        let mut boxes = vec![Aabb::EMPTY; np];
+        for (t, &k) in self.part_of.iter().enumerate() {
+            boxes[k as usize] =
+                boxes[k as usize].union(&Aabb::from_points(self.d.tet_points(t).iter()));
+        }
+        boxes
+    }
+    fn filter(&self, k: u32) -> Box<dyn RegionFilter + '_> {
+        Box::new(PartFilter {
+            loc: self.loc,
+            walls: &self.walls,
+            part: self.part_of,
+            k,
+        })
+    }
+}
+
 /// Meshes the region bounded by `faces` (normals inward) on `comm.parts()`
 /// parts. `size` is the fine size field; `point_size` the size at each
 /// input point.
@@ -195,14 +254,20 @@ pub fn mesh_parallel<C: Comm>(
         ..Default::default()
     };
     // §5 step 1: the DDG (replicated: it is small).
-    let d = ddg::build(
-        points.to_vec(),
-        point_size.to_vec(),
-        faces.to_vec(),
-        opts.growth,
-        ddg::DdgMode::default(),
-    )
-    .map_err(PassError::Ddg)?;
+    let d = if opts.ddg_passes > 0 {
+        let (d, bs) = build_ddg(points, point_size, faces, opts.growth, opts.ddg_passes, comm)?;
+        st.ddg_build = Some(bs);
+        d
+    } else {
+        ddg::build(
+            points.to_vec(),
+            point_size.to_vec(),
+            faces.to_vec(),
+            opts.growth,
+            ddg::DdgMode::default(),
+        )
+        .map_err(PassError::Ddg)?
+    };
     st.ddg_tets = d.tets.len();
     st.ddg_points = d.points.len();
     st.ddg_surface_points = d.n_input;
@@ -238,14 +303,16 @@ pub fn mesh_parallel<C: Comm>(
     // §7 step 3, passes 1 to 3.
     for (j, part_of) in [&part0, &part2, &part3].into_iter().enumerate() {
         let t0 = Instant::now();
-        let walls = Interfaces::new(&d, part_of);
+        let regions = DdgRegions {
+            d: &d,
+            loc: &loc,
+            walls: Interfaces::new(&d, part_of),
+            part_of,
+        };
         let (tets, secs) = parallel_pass(
             &mut parts,
             comm,
-            &d,
-            &loc,
-            &walls,
-            part_of,
+            &regions,
             size,
             j as u8 + 1,
             &mut next_gid,
@@ -312,23 +379,17 @@ pub fn mesh_parallel<C: Comm>(
 /// box it meets (so that each part knows every face bounding its region);
 /// every part advances its faces; new points get global ids. Returns the
 /// tets and the front seconds of each part.
-#[allow(clippy::too_many_arguments)]
 fn parallel_pass<C: Comm>(
     parts: &mut [Part],
     comm: &C,
-    d: &Ddg,
-    loc: &Locator,
-    walls: &Interfaces,
-    part_of: &[u32],
+    regions: &dyn Regions,
     size: &(dyn Fn(P3) -> f64 + Sync),
     pass: u8,
     next_gid: &mut u32,
 ) -> Result<(Vec<usize>, Vec<f64>), PassError> {
     let np = parts.len();
-    let mut boxes = vec![Aabb::EMPTY; np];
-    for (t, &k) in part_of.iter().enumerate() {
-        boxes[k as usize] = boxes[k as usize].union(&Aabb::from_points(d.tet_points(t).iter()));
-    }
+    let mut boxes = regions.bounds();
+    boxes.resize(np, Aabb::EMPTY);
     let boxes: Vec<Aabb> = boxes
         .iter()
         .map(|b| {
@@ -349,8 +410,7 @@ fn parallel_pass<C: Comm>(
             let mut keep = Vec::new();
             for &f in &part.front {
                 let o = f.map(|i| {
-                    *owner[i as usize]
-                        .get_or_insert_with(|| loc.owner(part.pts[i as usize], part_of))
+                    *owner[i as usize].get_or_insert_with(|| regions.owner(part.pts[i as usize]))
                 });
                 let own = if o[0].is_some() && o[0] == o[1] && o[1] == o[2] {
                     o[0]
@@ -379,7 +439,7 @@ fn parallel_pass<C: Comm>(
     let made: Vec<Made> = inboxes
         .into_par_iter()
         .enumerate()
-        .map(|(k, inbox)| front_call(inbox, k as u32, loc, walls, part_of, size))
+        .map(|(k, inbox)| front_call(inbox, k as u32, regions, size))
         .collect::<Result<_, (usize, FrontError)>>()
         .map_err(|(part, source)| PassError::Pass { pass, part, source })?;
 
@@ -415,9 +475,7 @@ fn parallel_pass<C: Comm>(
 fn front_call(
     inbox: Vec<(u32, FaceMsg)>,
     k: u32,
-    loc: &Locator,
-    walls: &Interfaces,
-    part_of: &[u32],
+    regions: &dyn Regions,
     size: &(dyn Fn(P3) -> f64 + Sync),
 ) -> Result<Made, (usize, FrontError)> {
     let t0 = Instant::now();
@@ -437,21 +495,16 @@ fn front_call(
             .flat_map(|owned| inbox.iter().filter(move |m| m.1.owned == owned))
             .map(|(_, m)| &m.v),
     );
-    let filter = PartFilter {
-        loc,
-        walls,
-        part: part_of,
-        k,
-    };
+    let filter = regions.filter(k);
     let input_ok: Vec<bool> = input
         .points
         .iter()
-        .map(|&p| loc.owner(p, part_of) == Some(k))
+        .map(|&p| regions.owner(p) == Some(k))
         .collect();
     let res = advance(
         input,
         SizeMode::Field(size),
-        &filter,
+        &*filter,
         &FrontOptions {
             pass: true,
             ..FrontOptions::default()
@@ -468,7 +521,7 @@ fn front_call(
     let stuck = res
         .front
         .iter()
-        .map(|f| is_stuck(&res, *f, &filter))
+        .map(|f| is_stuck(&res, *f, &*filter))
         .collect();
     Ok(Made {
         res: Some(res),
@@ -664,8 +717,7 @@ fn absorb(part: &mut Part, m: Made, base: u32, pass: u8) -> usize {
 /// Whether face `f` of a pass's result got stuck: the region rules of §7
 /// let the front try it (points and edges inside, the ideal point inside,
 /// computed as the front does), but no tet was accepted.
-fn is_stuck(res: &parafront_front::FrontResult, f: [u32; 3], filter: &PartFilter) -> bool {
-    use parafront_front::RegionFilter;
+fn is_stuck(res: &parafront_front::FrontResult, f: [u32; 3], filter: &dyn RegionFilter) -> bool {
     use parafront_geom::{add, cross, dist, normalize, scale, sub};
     let p = f.map(|i| res.points[i as usize]);
     let inside = p.iter().all(|&q| filter.point_ok(q))

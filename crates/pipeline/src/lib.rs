@@ -36,6 +36,11 @@ pub struct MeshOptions {
     /// DDG growth factor `c_i` (§5); 0 takes the default (1.6).
     #[serde(default)]
     pub ddg_growth: f64,
+    /// Parallel passes that build the DDG (then a serial pass on what they
+    /// leave); 0 builds it with the serial front; unset takes the default
+    /// (`parafront_passes::DEFAULT_DDG_PASSES`).
+    #[serde(default)]
+    pub ddg_passes: Option<usize>,
     /// Skip the final validity check (not recommended; it is cheap).
     #[serde(default)]
     pub no_check: bool,
@@ -65,6 +70,7 @@ impl Default for MeshOptions {
             threads: 0,
             parts: 1,
             ddg_growth: 0.0,
+            ddg_passes: None,
             no_check: false,
             debug_partial: false,
             progress: None,
@@ -300,6 +306,9 @@ fn mesh_parts(
         } else {
             parafront_ddg::DEFAULT_GROWTH
         },
+        ddg_passes: opts
+            .ddg_passes
+            .unwrap_or(parafront_passes::DEFAULT_DDG_PASSES),
         ..ParOptions::default()
     };
     let comm = parafront_comm::Threads::new(opts.parts);
