@@ -8,7 +8,7 @@ mod field;
 mod locate;
 mod partition;
 
-pub use field::GradedField;
+pub use field::{edge_sizes, GradedField};
 
 pub use locate::{Interfaces, Locator, PartFilter};
 pub use partition::{imbalance, rcb, shifted, tet_weights, Shift};

@@ -1,4 +1,5 @@
-//! Times the DDG's build alone: `ddg_time SURFACE PARTS THREADS,.. PASSES,.. REPS`.
+//! Times the DDG's build alone:
+//! `ddg_time SURFACE PARTS THREADS,.. PASSES,.. REPS [GROWTH [SURFACE_SIZE_SCALE]]`.
 //! PASSES 0 is the serial front; the surface's normals point out.
 use parafront_comm::Threads;
 use parafront_passes::build_ddg;
@@ -12,8 +13,10 @@ fn main() {
     let threads = list(&a[3]);
     let passes = list(&a[4]);
     let reps: usize = a[5].parse().unwrap();
+    let c: f64 = a.get(6).map_or(1.6, |x| x.parse().unwrap());
+    let hscale: f64 = a.get(7).map_or(1.0, |x| x.parse().unwrap());
     let faces: Vec<[u32; 3]> = s.tris.iter().map(|t| [t[0], t[2], t[1]]).collect();
-    let hs = s.mean_edge_lengths();
+    let hs: Vec<f64> = s.mean_edge_lengths().iter().map(|h| h * hscale).collect();
     for &p in &passes {
         for &t in &threads {
             let pool = rayon::ThreadPoolBuilder::new().num_threads(t).build().unwrap();
@@ -26,16 +29,16 @@ fn main() {
                             s.points.clone(),
                             hs.clone(),
                             faces.clone(),
-                            1.6,
+                            c,
                             parafront_ddg::DdgMode::Graded,
                         )
                         .unwrap();
                         format!("{} tets", d.tets.len())
                     } else {
                         let (d, st) =
-                            build_ddg(&s.points, &hs, &faces, 1.6, p, &Threads::new(parts)).unwrap();
+                            build_ddg(&s.points, &faces, c, p, &Threads::new(parts)).unwrap();
                         if std::env::var_os("DDG_FIELD_TIME").is_some() {
-                            let f = parafront_ddg::graded_field(&s.points, &faces, 1.6).unwrap();
+                            let f = parafront_ddg::graded_field(&s.points, &faces, c).unwrap();
                             let t0 = Instant::now();
                             let x: f64 = d.points[d.n_input..].iter().map(|&p| f(p)).sum();
                             println!(

@@ -213,13 +213,21 @@ fn frame(j: usize) -> [P3; 3] {
     r
 }
 
+/// The DDG's surface points get this many times their mean edge length
+/// as their size: the first layer of tets as tall as the front makes them
+/// (at most twice a face's longest edge). §5 multiplies the initial sizes
+/// by `c`; with 2 instead of 1.6 the DDG of sphere_1e6 has 131k tets
+/// instead of 213k (257k at 1), in half the time: tall tets on
+/// neighbouring surface triangles share their apexes.
+pub const FIRST_LAYER: f64 = 2.0;
+
 /// Builds the DDG of the closed front `faces` (normals inward) with
 /// growth `c` (the graded sizes of [`DdgMode::Graded`]): `passes` parallel
 /// passes on `comm.parts()` convex cells each, then the serial pass on
-/// what they left.
+/// what they left. The sizes are the DDG's own, from the front's edges
+/// (the fine mesh's sizes do not enter).
 pub fn build_ddg<C: Comm>(
     points: &[P3],
-    point_size: &[f64],
     faces: &[[u32; 3]],
     c: f64,
     passes: usize,
@@ -231,6 +239,10 @@ pub fn build_ddg<C: Comm>(
     let t0 = Instant::now();
     let field = ddg::graded_field(points, faces, c)?;
     st.field_seconds = t0.elapsed().as_secs_f64();
+    let point_size: Vec<f64> = ddg::edge_sizes(points, faces)
+        .iter()
+        .map(|h| FIRST_LAYER * h)
+        .collect();
     let domain = Aabb::from_points(points.iter());
     let domain = domain.inflated(1e-6 * domain.diagonal().max(1e-300));
 

@@ -255,7 +255,7 @@ pub fn mesh_parallel<C: Comm>(
     };
     // §5 step 1: the DDG (replicated: it is small).
     let d = if opts.ddg_passes > 0 {
-        let (d, bs) = build_ddg(points, point_size, faces, opts.growth, opts.ddg_passes, comm)?;
+        let (d, bs) = build_ddg(points, faces, opts.growth, opts.ddg_passes, comm)?;
         st.ddg_build = Some(bs);
         d
     } else {
