@@ -78,6 +78,12 @@ pub struct ParStats {
     /// The DDG used the graded field (the per-face growth got stuck).
     pub ddg_graded: bool,
     pub ddg_seconds: f64,
+    /// CPU seconds (all threads) of the DDG and of the partition, where
+    /// the system tells ([`process_cpu_seconds`]; 0 elsewhere): on a
+    /// shared machine their share of a run's CPU time is steadier than
+    /// their share of its wall time.
+    pub ddg_cpu_seconds: f64,
+    pub partition_cpu_seconds: f64,
     /// With a DDG built by passes: what each pass made.
     pub ddg_build: Option<DdgBuildStats>,
     pub partition_seconds: f64,
@@ -112,6 +118,20 @@ impl ParStats {
             + self.pass_seconds[3]
             + self.redistribute_seconds
     }
+}
+
+/// CPU seconds this process has used so far, all threads together, from
+/// `/proc/self/stat` (10 ms ticks); `None` where there is no such file.
+pub fn process_cpu_seconds() -> Option<f64> {
+    let s = std::fs::read_to_string("/proc/self/stat").ok()?;
+    // Fields after the command (which may hold spaces): state is field 3,
+    // utime and stime fields 14 and 15, in clock ticks (100 per second on
+    // Linux).
+    let rest = s.get(s.rfind(')')? + 1..)?;
+    let f: Vec<&str> = rest.split_whitespace().collect();
+    let ut: f64 = f.get(11)?.parse().ok()?;
+    let st: f64 = f.get(12)?.parse().ok()?;
+    Some((ut + st) / 100.0)
 }
 
 /// The merged mesh and the partitioned one.
@@ -228,12 +248,7 @@ impl Regions for DdgRegions<'_> {
         boxes
     }
     fn filter(&self, k: u32) -> Box<dyn RegionFilter + '_> {
-        Box::new(PartFilter {
-            loc: self.loc,
-            walls: &self.walls,
-            part: self.part_of,
-            k,
-        })
+        Box::new(PartFilter::new(self.loc, &self.walls, self.part_of, k))
     }
 }
 
@@ -254,6 +269,7 @@ pub fn mesh_parallel<C: Comm>(
         ..Default::default()
     };
     // §5 step 1: the DDG (replicated: it is small).
+    let cpu0 = process_cpu_seconds();
     let d = if opts.ddg_passes > 0 {
         let (d, bs) = build_ddg(points, faces, opts.growth, opts.ddg_passes, comm)?;
         st.ddg_build = Some(bs);
@@ -275,15 +291,32 @@ pub fn mesh_parallel<C: Comm>(
     st.ddg_graded = d.mode == ddg::DdgMode::Graded;
     st.ddg_seconds = d.seconds;
 
+    let cpu1 = process_cpu_seconds();
     // §6 step 2: weights and the balanced split.
     let t0 = Instant::now();
     let loc = Locator::new(&d);
+    let t_loc = t0.elapsed().as_secs_f64();
     let w = ddg::tet_weights(&d, size);
+    let t_w = t0.elapsed().as_secs_f64();
     let part0 = ddg::rcb(&d, &w, np);
+    let t_rcb = t0.elapsed().as_secs_f64();
     st.predicted_imbalance = ddg::imbalance(&part0, &w, np);
     let part2 = ddg::shifted(&d, &part0, Shift::FromHigher, opts.layers);
     let part3 = ddg::shifted(&d, &part0, Shift::FromLower, opts.layers);
     st.partition_seconds = t0.elapsed().as_secs_f64();
+    let cpu2 = process_cpu_seconds();
+    if let (Some(a), Some(b), Some(c)) = (cpu0, cpu1, cpu2) {
+        st.ddg_cpu_seconds = b - a;
+        st.partition_cpu_seconds = c - b;
+    }
+    if std::env::var_os("PARAFRONT_DEBUG_PASSES").is_some() {
+        eprintln!(
+            "partition: locator {t_loc:.3} s, weights {:.3} s, rcb {:.3} s, shifts {:.3} s",
+            t_w - t_loc,
+            t_rcb - t_w,
+            st.partition_seconds - t_rcb
+        );
+    }
 
     // The input front starts on part 0 (the reader); pass 1 sends it out.
     let mut parts: Vec<Part> = (0..np).map(|_| Part::default()).collect();
@@ -488,6 +521,7 @@ fn front_call(
             seconds: 0.0,
         });
     }
+    let n_owned = inbox.iter().filter(|m| m.1.owned).count();
     // Owned faces first: their points get the low local ids.
     let (input, gids) = local_front(
         [true, false]
@@ -511,18 +545,29 @@ fn front_call(
         },
     )
     .map_err(|e| (k as usize, e))?;
+    let t_front = t0.elapsed().as_secs_f64();
     let mut res = res;
     let n_in = gids.len();
-    close_pockets(
+    let pocket_tets = close_pockets(
         &mut res,
         |i| i as usize >= n_in || input_ok[i as usize],
         size,
     );
-    let stuck = res
+    let t_pockets = t0.elapsed().as_secs_f64() - t_front;
+    let stuck: Vec<bool> = res
         .front
         .iter()
         .map(|f| is_stuck(&res, *f, &*filter))
         .collect();
+    if std::env::var_os("PARAFRONT_DEBUG_PASSES").is_some() {
+        eprintln!(
+            "part {k}: {} points in, {} owned faces, {} tets, front {t_front:.3} s, pockets {t_pockets:.3} s ({pocket_tets} tets), stuck check {:.3} s",
+            gids.len(),
+            n_owned,
+            res.tets.len(),
+            t0.elapsed().as_secs_f64() - t_front - t_pockets
+        );
+    }
     Ok(Made {
         res: Some(res),
         input_gid: gids,
