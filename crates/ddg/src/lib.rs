@@ -124,24 +124,28 @@ pub fn graded_field(
 /// `u32::MAX` on the boundary. Fails on a face shared by more than two
 /// tets.
 pub fn face_neighbours(tets: &[[u32; 4]]) -> Result<Vec<u32>, String> {
-    let mut faces: Vec<([u32; 3], u32)> = Vec::with_capacity(4 * tets.len());
-    for (t, tv) in tets.iter().enumerate() {
-        for f in 0..4 {
-            let mut k = [0u32; 3];
-            let mut n = 0;
-            for (i, &p) in tv.iter().enumerate() {
-                if i != f {
-                    k[n] = p;
-                    n += 1;
+    use rayon::prelude::*;
+    let mut faces: Vec<([u32; 3], u32)> = tets
+        .par_iter()
+        .enumerate()
+        .flat_map_iter(|(t, tv)| {
+            (0..4).map(move |f| {
+                let mut k = [0u32; 3];
+                let mut n = 0;
+                for (i, &p) in tv.iter().enumerate() {
+                    if i != f {
+                        k[n] = p;
+                        n += 1;
+                    }
                 }
-            }
-            k.sort_unstable();
-            faces.push((k, 4 * t as u32 + f as u32));
-        }
-    }
+                k.sort_unstable();
+                (k, 4 * t as u32 + f as u32)
+            })
+        })
+        .collect();
     // Keys and slots are unique pairs: the order does not depend on the
-    // sort.
-    faces.sort_unstable();
+    // sort, nor on the threads.
+    faces.par_sort_unstable();
     let mut neigh = vec![u32::MAX; 4 * tets.len()];
     let mut i = 0;
     while i < faces.len() {
