@@ -26,6 +26,16 @@ pub fn print_parallel(sum: &Summary) {
             "  DDG and partition: {:.3} + {:.3} s wall, {:.2} + {:.2} s CPU",
             st.ddg_seconds, st.partition_seconds, st.ddg_cpu_seconds, st.partition_cpu_seconds
         );
+        if let Some(b) = &st.ddg_build {
+            println!(
+                "  DDG built by {} parallel passes and a serial one: tets {:?}, seconds {:.3?} (field {:.3} s, merge {:.3} s)",
+                b.pass_tets.len() - 1,
+                b.pass_tets,
+                b.pass_seconds,
+                b.field_seconds,
+                b.merge_seconds
+            );
+        }
         println!(
             "  imbalance (max/mean): predicted {:.3}, made in passes 1-3 {:.3}, held after redistribution {:.3}",
             st.predicted_imbalance, st.made_imbalance, st.held_imbalance
