@@ -37,6 +37,30 @@ fn main() {
                     } else {
                         let (d, st) =
                             build_ddg(&s.points, &faces, c, p, &Threads::new(parts)).unwrap();
+                        if std::env::var_os("DDG_PARTITION_TIME").is_some() {
+                            use parafront_ddg as g;
+                            let t0 = Instant::now();
+                            let loc = g::Locator::new(&d);
+                            let t1 = t0.elapsed().as_secs_f64();
+                            let w = g::tet_weights(&d, &|_p| 0.02);
+                            let t2 = t0.elapsed().as_secs_f64();
+                            let p0 = g::rcb(&d, &w, parts);
+                            let t3 = t0.elapsed().as_secs_f64();
+                            let _ = g::shifted(&d, &p0, g::Shift::FromHigher, 2);
+                            let _ = g::shifted(&d, &p0, g::Shift::FromLower, 2);
+                            let t4 = t0.elapsed().as_secs_f64();
+                            let _ = g::Interfaces::new(&d, &p0);
+                            let t5 = t0.elapsed().as_secs_f64();
+                            let mut n = 0usize;
+                            for &p in &d.points {
+                                n += loc.owner(p, &p0).is_some() as usize;
+                            }
+                            let t6 = t0.elapsed().as_secs_f64();
+                            println!(
+                                "locator {t1:.3} weights {:.3} rcb {:.3} shifts {:.3} interfaces {:.3} s; {} owner queries {:.3} s ({n} owned)",
+                                t2 - t1, t3 - t2, t4 - t3, t5 - t4, d.points.len(), t6 - t5
+                            );
+                        }
                         if std::env::var_os("DDG_FIELD_TIME").is_some() {
                             let f = parafront_ddg::graded_field(&s.points, &faces, c).unwrap();
                             let t0 = Instant::now();

@@ -270,9 +270,26 @@ pub fn mesh_parallel<C: Comm>(
     };
     // §5 step 1: the DDG (replicated: it is small).
     let cpu0 = process_cpu_seconds();
-    let d = if opts.ddg_passes > 0 {
-        let (d, bs) = build_ddg(points, faces, opts.growth, opts.ddg_passes, comm)?;
-        st.ddg_build = Some(bs);
+    let t_ddg = Instant::now();
+    let built = if opts.ddg_passes > 0 {
+        match build_ddg(points, faces, opts.growth, opts.ddg_passes, comm) {
+            Ok((d, bs)) => {
+                st.ddg_build = Some(bs);
+                Some(d)
+            }
+            // The serial front gets another go (deterministic: the same
+            // failure on any thread count); `ddg_build` stays `None`.
+            Err(e) => {
+                if std::env::var_os("PARAFRONT_DEBUG_PASSES").is_some() {
+                    eprintln!("the DDG's passes failed ({e}); the serial front builds it");
+                }
+                None
+            }
+        }
+    } else {
+        None
+    };
+    let d = if let Some(d) = built {
         d
     } else {
         ddg::build(
@@ -289,7 +306,8 @@ pub fn mesh_parallel<C: Comm>(
     st.ddg_surface_points = d.n_input;
     st.ddg_growth = d.growth;
     st.ddg_graded = d.mode == ddg::DdgMode::Graded;
-    st.ddg_seconds = d.seconds;
+    // A failed try of the passes included.
+    st.ddg_seconds = t_ddg.elapsed().as_secs_f64();
 
     let cpu1 = process_cpu_seconds();
     // §6 step 2: weights and the balanced split.
