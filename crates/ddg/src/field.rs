@@ -99,8 +99,8 @@ impl GradedField {
     #[inline]
     fn bound(&self, nd: &Node, x: P3) -> f64 {
         let mut d2 = 0.0;
-        for k in 0..3 {
-            let e = (nd.lo[k] - x[k]).max(x[k] - nd.hi[k]).max(0.0);
+        for (k, &xk) in x.iter().enumerate() {
+            let e = (nd.lo[k] - xk).max(xk - nd.hi[k]).max(0.0);
             d2 += e * e;
         }
         nd.hmin + self.slope * d2.sqrt()
@@ -190,13 +190,20 @@ mod tests {
         let f = GradedField::new(seeds.clone(), 0.6);
         for i in 0..500 {
             let t = i as f64;
-            let x = [(t * 1.7).sin() * 1.3, (t * 0.3).cos(), (t * 2.9).sin() * 0.5];
+            let x = [
+                (t * 1.7).sin() * 1.3,
+                (t * 0.3).cos(),
+                (t * 2.9).sin() * 0.5,
+            ];
             let exact = seeds
                 .iter()
                 .map(|&(p, h)| h + 0.6 * dist(x, p))
                 .fold(f64::INFINITY, f64::min);
             let got = f.size(x);
-            assert!(got >= exact && got <= exact * (1.0 + TOL) + 1e-15, "{got} vs {exact}");
+            assert!(
+                got >= exact && got <= exact * (1.0 + TOL) + 1e-15,
+                "{got} vs {exact}"
+            );
         }
     }
 }

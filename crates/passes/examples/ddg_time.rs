@@ -19,7 +19,10 @@ fn main() {
     let hs: Vec<f64> = s.mean_edge_lengths().iter().map(|h| h * hscale).collect();
     for &p in &passes {
         for &t in &threads {
-            let pool = rayon::ThreadPoolBuilder::new().num_threads(t).build().unwrap();
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(t)
+                .build()
+                .unwrap();
             let mut secs = Vec::new();
             for _ in 0..reps {
                 let t0 = Instant::now();
@@ -86,7 +89,10 @@ fn main() {
                 println!("passes {p} threads {t}: {dt:.3} s; {line}");
             }
             secs.sort_by(f64::total_cmp);
-            println!("passes {p} threads {t}: median {:.3} s", secs[secs.len() / 2]);
+            println!(
+                "passes {p} threads {t}: median {:.3} s",
+                secs[secs.len() / 2]
+            );
         }
     }
 }

@@ -102,7 +102,11 @@ impl Cells {
         }
         self.nodes.push(Node::Leaf(first)); // replaced below
         let ax = Aabb::from_points(ids.iter().map(|&i| &q[i as usize])).longest_axis();
-        ids.sort_unstable_by(|&a, &b| q[a as usize][ax].total_cmp(&q[b as usize][ax]).then(a.cmp(&b)));
+        ids.sort_unstable_by(|&a, &b| {
+            q[a as usize][ax]
+                .total_cmp(&q[b as usize][ax])
+                .then(a.cmp(&b))
+        });
         let left = parts / 2;
         let cut = (ids.len() * left as usize / parts as usize).clamp(1, ids.len() - 1);
         let at = 0.5 * (q[ids[cut - 1] as usize][ax] + q[ids[cut] as usize][ax]);
@@ -174,8 +178,8 @@ fn unrotate(r: &[P3; 3], q: P3) -> P3 {
 fn corners(b: &Aabb) -> [P3; 8] {
     let mut c = [[0.0; 3]; 8];
     for (i, x) in c.iter_mut().enumerate() {
-        for k in 0..3 {
-            x[k] = if i >> k & 1 == 0 { b.min[k] } else { b.max[k] };
+        for (k, xk) in x.iter_mut().enumerate() {
+            *xk = if i >> k & 1 == 0 { b.min[k] } else { b.max[k] };
         }
     }
     c
@@ -283,7 +287,8 @@ pub fn build_ddg<C: Comm>(
             break;
         }
         let cells = Cells::new(&cen, np, frame(j), &domain);
-        let (tets, _) = parallel_pass(&mut parts, comm, &cells, &field, j as u8 + 1, &mut next_gid)?;
+        let (tets, _) =
+            parallel_pass(&mut parts, comm, &cells, &field, j as u8 + 1, &mut next_gid)?;
         let peeled = peel_stuck(&mut parts, comm);
         if debug {
             let fr: usize = parts.iter().map(|p| p.front.len()).sum();

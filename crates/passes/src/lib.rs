@@ -239,7 +239,12 @@ impl Regions for DdgRegions<'_> {
         self.loc.owner(p, self.part_of)
     }
     fn bounds(&self) -> Vec<Aabb> {
-        let np = self.part_of.iter().map(|&k| k as usize + 1).max().unwrap_or(0);
+        let np = self
+            .part_of
+            .iter()
+            .map(|&k| k as usize + 1)
+            .max()
+            .unwrap_or(0);
         let mut boxes = vec![Aabb::EMPTY; np];
         for (t, &k) in self.part_of.iter().enumerate() {
             boxes[k as usize] =
@@ -360,14 +365,8 @@ pub fn mesh_parallel<C: Comm>(
             walls: Interfaces::new(&d, part_of),
             part_of,
         };
-        let (tets, secs) = parallel_pass(
-            &mut parts,
-            comm,
-            &regions,
-            size,
-            j as u8 + 1,
-            &mut next_gid,
-        )?;
+        let (tets, secs) =
+            parallel_pass(&mut parts, comm, &regions, size, j as u8 + 1, &mut next_gid)?;
         for (k, &n) in tets.iter().enumerate() {
             made_per_part[k] += n;
         }

@@ -9,8 +9,8 @@ pub use regions::{material_regions, RegionFront};
 
 use parafront_front::{advance, FrontError, FrontInput, FrontOptions, SizeMode};
 use parafront_mesh::{CheckError, PointId, QualityReport, TetMesh};
-use parafront_passes::{mesh_parallel, ParOptions, ParStats, PassError, Piece};
 pub use parafront_passes::process_cpu_seconds;
+use parafront_passes::{mesh_parallel, ParOptions, ParStats, PassError, Piece};
 use parafront_size::{SizeError, SizeField, SizeOptions, Sizing};
 use parafront_surface::validate::{validate, Report};
 use parafront_surface::Surface;
