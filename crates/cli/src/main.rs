@@ -83,6 +83,9 @@ enum Cmd {
         /// DDG partition methods to run, comma separated (metis, rcb).
         #[arg(long, value_delimiter = ',', default_value = "metis")]
         partition: Vec<parafront_pipeline::Partition>,
+        /// Parallel passes that build the DDG (0: the serial front).
+        #[arg(long)]
+        ddg_passes: Option<usize>,
     },
     /// Convert a tet mesh between formats (.vtu, .msh, .mesh).
     Convert {
@@ -125,6 +128,10 @@ struct MeshArgs {
     /// bisection).
     #[arg(long, default_value = "metis")]
     partition: parafront_pipeline::Partition,
+    /// Parallel passes that build the DDG before a serial pass closes it
+    /// (0: the serial front builds it)
+    #[arg(long)]
+    ddg_passes: Option<usize>,
     /// With --parts > 1, also write the partitioned mesh: this .pvtu and
     /// one .vtu per part beside it.
     #[arg(long)]
@@ -203,7 +210,8 @@ fn main() -> ExitCode {
             parts,
             threads,
             partition,
-        } => parallel::run_bench(&surface, size, &parts, &threads, &partition),
+            ddg_passes,
+        } => parallel::run_bench(&surface, size, &parts, &threads, &partition, ddg_passes),
         Cmd::Quality { mesh, plot, before } => {
             run_quality(&mesh, plot.as_deref(), before.as_deref())
         }
@@ -265,6 +273,7 @@ fn mesh_options(a: &MeshArgs) -> Result<MeshOptions, Fail> {
     o.parts = a.parts;
     o.ddg_growth = a.ddg_growth.unwrap_or(0.0);
     o.partition = a.partition;
+    o.ddg_passes = a.ddg_passes;
     if a.pvtu.is_some() && o.optimize > 0 {
         // The pieces are the generation's partition (§8); improvement
         // (§9) changes the mesh after it and does not renumber them yet.

@@ -31,6 +31,20 @@ pub fn print_parallel(sum: &Summary) {
             st.split_seconds
         );
         println!(
+            "  DDG and partition: {:.3} + {:.3} s wall, {:.2} + {:.2} s CPU",
+            st.ddg_seconds, st.partition_seconds, st.ddg_cpu_seconds, st.partition_cpu_seconds
+        );
+        if let Some(b) = &st.ddg_build {
+            println!(
+                "  DDG built by {} parallel passes and a serial one: tets {:?}, seconds {:.3?} (field {:.3} s, merge {:.3} s)",
+                b.pass_tets.len() - 1,
+                b.pass_tets,
+                b.pass_seconds,
+                b.field_seconds,
+                b.merge_seconds
+            );
+        }
+        println!(
             "  imbalance (max/mean): predicted {:.3}, made in passes 1-3 {:.3}, held after redistribution {:.3}",
             st.predicted_imbalance, st.made_imbalance, st.held_imbalance
         );
@@ -137,6 +151,7 @@ pub fn run_bench(
     parts: &[usize],
     threads: &[usize],
     methods: &[parafront_pipeline::Partition],
+    ddg_passes: Option<usize>,
 ) -> Result<(), Fail> {
     let s = parafront_surface::read::read_surface(path)?;
     println!(
@@ -146,11 +161,11 @@ pub fn run_bench(
         s.tris.len()
     );
     println!(
-        "{:>5} {:>5} {:>5} {:>9} {:>9} {:>11} {:>11} | {:>7} {:>7} {:>7} {:>7} {:>7} {:>7} | {:>6} {:>6} {:>6} {:>6} | {:>6} {:>6} {:>8} | {:>5} {:>6} {:>8} {:>4} {:>7}",
+        "{:>5} {:>5} {:>5} {:>9} {:>9} {:>11} {:>11} | {:>7} {:>7} {:>7} {:>7} {:>7} {:>7} | {:>6} {:>6} {:>6} {:>6} | {:>6} {:>6} {:>8} | {:>5} {:>6} {:>8} {:>4} {:>7} | {:>8} {:>6} {:>6}",
         "nproc", "nprol", "ncore", "nelem", "CPU s", "AbsSpeed", "RelSpeed",
         "ddg", "part", "pass1", "pass2", "pass3", "pass4",
         "%p1", "%p2", "%p3", "%p4", "imbP", "imbH", "crit s",
-        "split", "cut", "cutF", "pcs", "split s"
+        "split", "cut", "cutF", "pcs", "split s", "cpu s", "%ddgW", "%ddgC"
     );
     let mut base: Option<f64> = None;
     for &p in parts {
@@ -168,14 +183,24 @@ pub fn run_bench(
                     threads: t,
                     optimize: 0,
                     partition: method,
+                    ddg_passes,
                     ..Default::default()
                 };
                 o.size.h = size;
                 let t0 = std::time::Instant::now();
+                let cpu0 = parafront_pipeline::process_cpu_seconds();
                 let (m, sum) = pool
                     .install(|| parafront_pipeline::mesh_surface(&s, &o))
                     .map_err(|e| Fail(1, format!("parts {p}, threads {t}: {e}")))?;
                 let secs = t0.elapsed().as_secs_f64();
+                let cpu = parafront_pipeline::process_cpu_seconds()
+                    .zip(cpu0)
+                    .map_or(0.0, |(a, b)| a - b);
+                let ddg_cpu: f64 = sum
+                    .parallel
+                    .iter()
+                    .map(|x| x.ddg_cpu_seconds + x.partition_cpu_seconds)
+                    .sum();
                 let n = m.tets.len();
                 let cores = t.max(1);
                 let nprol = (cores / p.max(1)).max(1);
@@ -213,7 +238,7 @@ pub fn run_bench(
                 };
                 base.get_or_insert(secs);
                 println!(
-                "{:>5} {:>5} {:>5} {:>9} {:>9.2} {:>11.0} {:>11.0} | {:>7.2} {:>7.2} {:>7.2} {:>7.2} {:>7.2} {:>7.2} | {:>6.2} {:>6.2} {:>6.2} {:>6.2} | {:>6.3} {:>6.3} {:>8.2} | {:>5} {:>6} {:>8.0} {:>4} {:>7.3}",
+                "{:>5} {:>5} {:>5} {:>9} {:>9.2} {:>11.0} {:>11.0} | {:>7.2} {:>7.2} {:>7.2} {:>7.2} {:>7.2} {:>7.2} | {:>6.2} {:>6.2} {:>6.2} {:>6.2} | {:>6.3} {:>6.3} {:>8.2} | {:>5} {:>6} {:>8.0} {:>4} {:>7.3} | {:>8.2} {:>6.2} {:>6.2}",
                 p, nprol, cores, n, secs, n as f64 / secs, n as f64 / secs / cores as f64,
                 sum.seconds("ddg") + 0.0, sum.seconds("partition") + 0.0,
                 if p > 1 { sum.seconds("pass 1") } else { sum.seconds("front") } + 0.0,
@@ -225,7 +250,10 @@ pub fn run_bench(
                 st.map_or(0, |x| x.cut_faces),
                 st.map_or(0.0, |x| x.cut_fine_faces),
                 st.map_or(1, |x| x.max_components),
-                st.map_or(0.0, |x| x.split_seconds)
+                st.map_or(0.0, |x| x.split_seconds),
+                cpu,
+                100.0 * (sum.seconds("ddg") + sum.seconds("partition")) / secs + 0.0,
+                if cpu > 0.0 { 100.0 * ddg_cpu / cpu + 0.0 } else { 0.0 }
             );
             }
         }
@@ -238,6 +266,9 @@ pub fn run_bench(
     );
     println!(
         "crit s: the run with each parallel pass timed by its slowest part (one core per part)."
+    );
+    println!(
+        "cpu s: CPU seconds of the run, all threads; %ddgW, %ddgC: the DDG and its partition's share of the wall time and of the CPU time."
     );
     Ok(())
 }

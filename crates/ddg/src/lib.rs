@@ -4,8 +4,11 @@
 //! (§6, step 2), the shifted partitions of passes 2 and 3 and the region
 //! filter of one part (§7).
 
+mod field;
 mod locate;
 mod partition;
+
+pub use field::{edge_sizes, GradedField};
 
 pub use locate::{Interfaces, Locator, PartFilter};
 pub use partition::{
@@ -15,7 +18,6 @@ pub use partition::{
 
 use parafront_front::{advance, Everywhere, FrontError, FrontInput, FrontOptions, SizeMode};
 use parafront_geom::P3;
-use parafront_size::{SizeField, SizeOptions, Sizing};
 use std::time::Instant;
 
 /// Default growth factor `c_i` (§5: typical values 1.5 to 1.7).
@@ -94,16 +96,7 @@ pub fn build(
         )?;
         return Ok(done(r));
     }
-    let surf = parafront_surface::Surface::one_patch(points.clone(), faces.clone());
-    let sizing = Sizing::build(
-        &surf,
-        &SizeOptions {
-            gradation: c,
-            ..SizeOptions::default()
-        },
-        None,
-    )?;
-    let field = |p: P3| sizing.size(p);
+    let field = graded_field(&points, &faces, c)?;
     let r = advance(
         FrontInput {
             point_size,
@@ -115,6 +108,66 @@ pub fn build(
         &FrontOptions::default(),
     )?;
     Ok(done(r))
+}
+
+/// The sizes of [`DdgMode::Graded`]: the surface sizes of the closed
+/// front `faces` (the mean length of each point's edges) grown by `c - 1`
+/// per unit distance ([`GradedField`]).
+pub fn graded_field(
+    points: &[P3],
+    faces: &[[u32; 3]],
+    c: f64,
+) -> Result<impl Fn(P3) -> f64 + Sync, DdgError> {
+    let f = GradedField::of_front(points, faces, (c - 1.0).max(0.0));
+    Ok(move |p: P3| f.size(p))
+}
+
+/// Face neighbours of `tets` in the front's convention: `neigh[4t+f]` is
+/// `4t'+f'` for the tet across face `f` (the face opposite corner `f`),
+/// `u32::MAX` on the boundary. Fails on a face shared by more than two
+/// tets.
+pub fn face_neighbours(tets: &[[u32; 4]]) -> Result<Vec<u32>, String> {
+    use rayon::prelude::*;
+    let mut faces: Vec<([u32; 3], u32)> = tets
+        .par_iter()
+        .enumerate()
+        .flat_map_iter(|(t, tv)| {
+            (0..4).map(move |f| {
+                let mut k = [0u32; 3];
+                let mut n = 0;
+                for (i, &p) in tv.iter().enumerate() {
+                    if i != f {
+                        k[n] = p;
+                        n += 1;
+                    }
+                }
+                k.sort_unstable();
+                (k, 4 * t as u32 + f as u32)
+            })
+        })
+        .collect();
+    // Keys and slots are unique pairs: the order does not depend on the
+    // sort, nor on the threads.
+    faces.par_sort_unstable();
+    let mut neigh = vec![u32::MAX; 4 * tets.len()];
+    let mut i = 0;
+    while i < faces.len() {
+        let mut j = i + 1;
+        while j < faces.len() && faces[j].0 == faces[i].0 {
+            j += 1;
+        }
+        match j - i {
+            1 => {}
+            2 => {
+                let (a, b) = (faces[i].1, faces[i + 1].1);
+                neigh[a as usize] = b;
+                neigh[b as usize] = a;
+            }
+            n => return Err(format!("face {:?} is shared by {n} tets", faces[i].0)),
+        }
+        i = j;
+    }
+    Ok(neigh)
 }
 
 impl Ddg {

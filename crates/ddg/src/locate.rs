@@ -3,6 +3,7 @@ use crate::Ddg;
 use parafront_front::RegionFilter;
 use parafront_geom::intersect::{segment_triangle, SegTri};
 use parafront_geom::{orient3d, Aabb, P3};
+use std::sync::atomic::{AtomicU32, Ordering};
 
 /// A uniform grid of boxes (CSR cells), shared by the tet and face lookups.
 #[derive(Clone, Debug)]
@@ -159,17 +160,77 @@ impl Locator {
             if !self.bins.boxes[t as usize].contains(p) {
                 continue;
             }
-            let [a, b, c, d] = self.tets[t as usize];
-            // Inside the closed positive tet: no sub-tet with p in place of a
-            // vertex is negative.
-            if orient3d(p, b, c, d) >= 0.0
-                && orient3d(a, p, c, d) >= 0.0
-                && orient3d(a, b, p, d) >= 0.0
-                && orient3d(a, b, c, p) >= 0.0
-                && !f(t)
-            {
+            if self.closed_holds(t, p) && !f(t) {
                 return;
             }
+        }
+    }
+
+    /// Whether the closed tet `t` holds `p`: a corner of it (the surface
+    /// points are corners of DDG tets, and every predicate of a corner
+    /// takes the slow exact path), or no sub-tet with `p` in place of a
+    /// corner is negative.
+    #[inline]
+    fn closed_holds(&self, t: u32, p: P3) -> bool {
+        let [a, b, c, d] = self.tets[t as usize];
+        if p == a || p == b || p == c || p == d {
+            return true;
+        }
+        orient3d(p, b, c, d) >= 0.0
+            && orient3d(a, p, c, d) >= 0.0
+            && orient3d(a, b, p, d) >= 0.0
+            && orient3d(a, b, c, p) >= 0.0
+    }
+
+    /// Whether `p` lies strictly inside tet `t`: then `t` is its only host.
+    #[inline]
+    fn strictly_holds(&self, t: u32, p: P3) -> bool {
+        let [a, b, c, d] = self.tets[t as usize];
+        orient3d(p, b, c, d) > 0.0
+            && orient3d(a, p, c, d) > 0.0
+            && orient3d(a, b, p, d) > 0.0
+            && orient3d(a, b, c, p) > 0.0
+    }
+
+    /// [`Locator::owner`], trying first the tet in `hint` (the last one
+    /// found holding a point alone, updated here): a front asks about
+    /// points near each other, mostly inside one DDG tet. The answer does
+    /// not depend on the hint.
+    pub fn owner_near(&self, p: P3, part: &[u32], hint: &AtomicU32) -> Option<u32> {
+        let h = hint.load(Ordering::Relaxed);
+        if (h as usize) < self.tets.len()
+            && self.bins.boxes[h as usize].contains(p)
+            && self.strictly_holds(h, p)
+        {
+            return Some(part[h as usize]);
+        }
+        let mut own: Option<u32> = None;
+        let mut first = u32::MAX;
+        let mut hosts = 0;
+        let mut mixed = false;
+        self.hosts(p, |t| {
+            hosts += 1;
+            let k = part[t as usize];
+            match own {
+                None => {
+                    own = Some(k);
+                    first = t;
+                    true
+                }
+                Some(o) if o == k => true,
+                Some(_) => {
+                    mixed = true;
+                    false
+                }
+            }
+        });
+        if hosts == 1 {
+            hint.store(first, Ordering::Relaxed);
+        }
+        if mixed {
+            None
+        } else {
+            own
         }
     }
 
@@ -277,11 +338,25 @@ pub struct PartFilter<'a> {
     pub walls: &'a Interfaces,
     pub part: &'a [u32],
     pub k: u32,
+    /// The DDG tet of the last point located alone ([`Locator::owner_near`]).
+    pub hint: AtomicU32,
+}
+
+impl<'a> PartFilter<'a> {
+    pub fn new(loc: &'a Locator, walls: &'a Interfaces, part: &'a [u32], k: u32) -> Self {
+        PartFilter {
+            loc,
+            walls,
+            part,
+            k,
+            hint: AtomicU32::new(u32::MAX),
+        }
+    }
 }
 
 impl RegionFilter for PartFilter<'_> {
     fn point_ok(&self, p: P3) -> bool {
-        self.loc.owner(p, self.part) == Some(self.k)
+        self.loc.owner_near(p, self.part, &self.hint) == Some(self.k)
     }
     fn edge_ok(&self, a: P3, b: P3) -> bool {
         !self.walls.crosses(self.k, a, b)

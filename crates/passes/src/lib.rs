@@ -8,14 +8,18 @@
 //! this module and only ever touched by the closure of its own part); parts
 //! see each other's data only through the messages of a [`Comm`].
 
+mod ddg_build;
 mod redistribute;
 
+pub use ddg_build::{build_ddg, DdgBuildStats};
 pub use parafront_ddg::Partition;
 pub use redistribute::Piece;
 
 use parafront_comm::Comm;
 use parafront_ddg::{self as ddg, Ddg, Interfaces, Locator, PartFilter, Shift};
-use parafront_front::{advance, Everywhere, FrontError, FrontInput, FrontOptions, SizeMode};
+use parafront_front::{
+    advance, Everywhere, FrontError, FrontInput, FrontOptions, RegionFilter, SizeMode,
+};
 use parafront_geom::{Aabb, P3};
 use rayon::prelude::*;
 use rustc_hash::FxHashMap;
@@ -32,7 +36,14 @@ pub struct ParOptions {
     pub layers: usize,
     /// How the DDG is split (§6): METIS k-way or coordinate bisection.
     pub partition: ddg::Partition,
+    /// Parallel passes that build the DDG (on convex cells, then a serial
+    /// pass on what they leave: [`build_ddg`]); 0 builds it with the
+    /// serial front.
+    pub ddg_passes: usize,
 }
+
+/// Parallel passes of the DDG's build by default.
+pub const DEFAULT_DDG_PASSES: usize = 2;
 
 impl Default for ParOptions {
     fn default() -> Self {
@@ -41,6 +52,7 @@ impl Default for ParOptions {
             growth: ddg::DEFAULT_GROWTH,
             layers: 2,
             partition: ddg::Partition::default(),
+            ddg_passes: DEFAULT_DDG_PASSES,
         }
     }
 }
@@ -70,6 +82,14 @@ pub struct ParStats {
     /// The DDG used the graded field (the per-face growth got stuck).
     pub ddg_graded: bool,
     pub ddg_seconds: f64,
+    /// CPU seconds (all threads) of the DDG and of the partition, where
+    /// the system tells ([`process_cpu_seconds`]; 0 elsewhere): on a
+    /// shared machine their share of a run's CPU time is steadier than
+    /// their share of its wall time.
+    pub ddg_cpu_seconds: f64,
+    pub partition_cpu_seconds: f64,
+    /// With a DDG built by passes: what each pass made.
+    pub ddg_build: Option<DdgBuildStats>,
     pub partition_seconds: f64,
     /// Of which the split itself (RCB or METIS).
     pub split_seconds: f64,
@@ -111,6 +131,20 @@ impl ParStats {
             + self.pass_seconds[3]
             + self.redistribute_seconds
     }
+}
+
+/// CPU seconds this process has used so far, all threads together, from
+/// `/proc/self/stat` (10 ms ticks); `None` where there is no such file.
+pub fn process_cpu_seconds() -> Option<f64> {
+    let s = std::fs::read_to_string("/proc/self/stat").ok()?;
+    // Fields after the command (which may hold spaces): state is field 3,
+    // utime and stime fields 14 and 15, in clock ticks (100 per second on
+    // Linux).
+    let rest = s.get(s.rfind(')')? + 1..)?;
+    let f: Vec<&str> = rest.split_whitespace().collect();
+    let ut: f64 = f.get(11)?.parse().ok()?;
+    let st: f64 = f.get(12)?.parse().ok()?;
+    Some((ut + st) / 100.0)
 }
 
 /// The merged mesh and the partitioned one.
@@ -191,6 +225,51 @@ struct Made {
     seconds: f64,
 }
 
+/// Where the parts may mesh in one pass (§7): a conservative owner for
+/// each point, a box around each part's region (every front face meeting
+/// it goes to the part as context) and the region filter of a part. The
+/// passes of the fine mesh take their regions from the DDG; the passes
+/// that build the DDG itself, before any DDG exists, take convex cells.
+pub(crate) trait Regions: Sync {
+    /// `Some(k)` when `p` lies inside part `k`'s region, off its walls.
+    fn owner(&self, p: P3) -> Option<u32>;
+    /// Per part, a box around its region.
+    fn bounds(&self) -> Vec<Aabb>;
+    /// The region filter of part `k`.
+    fn filter(&self, k: u32) -> Box<dyn RegionFilter + '_>;
+}
+
+/// The regions of one DDG partition.
+struct DdgRegions<'a> {
+    d: &'a Ddg,
+    loc: &'a Locator,
+    walls: Interfaces,
+    part_of: &'a [u32],
+}
+
+impl Regions for DdgRegions<'_> {
+    fn owner(&self, p: P3) -> Option<u32> {
+        self.loc.owner(p, self.part_of)
+    }
+    fn bounds(&self) -> Vec<Aabb> {
+        let np = self
+            .part_of
+            .iter()
+            .map(|&k| k as usize + 1)
+            .max()
+            .unwrap_or(0);
+        let mut boxes = vec![Aabb::EMPTY; np];
+        for (t, &k) in self.part_of.iter().enumerate() {
+            boxes[k as usize] =
+                boxes[k as usize].union(&Aabb::from_points(self.d.tet_points(t).iter()));
+        }
+        boxes
+    }
+    fn filter(&self, k: u32) -> Box<dyn RegionFilter + '_> {
+        Box::new(PartFilter::new(self.loc, &self.walls, self.part_of, k))
+    }
+}
+
 /// Meshes the region bounded by `faces` (normals inward) on `comm.parts()`
 /// parts. `size` is the fine size field; `point_size` the size at each
 /// input point.
@@ -208,28 +287,57 @@ pub fn mesh_parallel<C: Comm>(
         ..Default::default()
     };
     // §5 step 1: the DDG (replicated: it is small).
-    let d = ddg::build(
-        points.to_vec(),
-        point_size.to_vec(),
-        faces.to_vec(),
-        opts.growth,
-        ddg::DdgMode::default(),
-    )
-    .map_err(PassError::Ddg)?;
+    let cpu0 = process_cpu_seconds();
+    let t_ddg = Instant::now();
+    let built = if opts.ddg_passes > 0 {
+        match build_ddg(points, faces, opts.growth, opts.ddg_passes, comm) {
+            Ok((d, bs)) => {
+                st.ddg_build = Some(bs);
+                Some(d)
+            }
+            // The serial front gets another go (deterministic: the same
+            // failure on any thread count); `ddg_build` stays `None`.
+            Err(e) => {
+                if std::env::var_os("PARAFRONT_DEBUG_PASSES").is_some() {
+                    eprintln!("the DDG's passes failed ({e}); the serial front builds it");
+                }
+                None
+            }
+        }
+    } else {
+        None
+    };
+    let d = if let Some(d) = built {
+        d
+    } else {
+        ddg::build(
+            points.to_vec(),
+            point_size.to_vec(),
+            faces.to_vec(),
+            opts.growth,
+            ddg::DdgMode::default(),
+        )
+        .map_err(PassError::Ddg)?
+    };
     st.ddg_tets = d.tets.len();
     st.ddg_points = d.points.len();
     st.ddg_surface_points = d.n_input;
     st.ddg_growth = d.growth;
     st.ddg_graded = d.mode == ddg::DdgMode::Graded;
-    st.ddg_seconds = d.seconds;
+    // A failed try of the passes included.
+    st.ddg_seconds = t_ddg.elapsed().as_secs_f64();
 
+    let cpu1 = process_cpu_seconds();
     // §6 step 2: weights and the balanced split.
     let t0 = Instant::now();
     let loc = Locator::new(&d);
+    let t_loc = t0.elapsed().as_secs_f64();
     let w = ddg::tet_weights(&d, size);
+    let t_w = t0.elapsed().as_secs_f64();
     let t1 = Instant::now();
     let part0 = ddg::partition(&d, &w, size, np, opts.partition);
     st.split_seconds = t1.elapsed().as_secs_f64();
+    let t_rcb = t0.elapsed().as_secs_f64();
     st.predicted_imbalance = ddg::imbalance(&part0, &w, np);
     let part2 = ddg::shifted(&d, &part0, Shift::FromHigher, opts.layers);
     let part3 = ddg::shifted(&d, &part0, Shift::FromLower, opts.layers);
@@ -241,6 +349,19 @@ pub fn mesh_parallel<C: Comm>(
         .into_iter()
         .max()
         .unwrap_or(0);
+    let cpu2 = process_cpu_seconds();
+    if let (Some(a), Some(b), Some(c)) = (cpu0, cpu1, cpu2) {
+        st.ddg_cpu_seconds = b - a;
+        st.partition_cpu_seconds = c - b;
+    }
+    if std::env::var_os("PARAFRONT_DEBUG_PASSES").is_some() {
+        eprintln!(
+            "partition: locator {t_loc:.3} s, weights {:.3} s, split {:.3} s, shifts {:.3} s",
+            t_w - t_loc,
+            t_rcb - t_w,
+            st.partition_seconds - t_rcb
+        );
+    }
 
     // The input front starts on part 0 (the reader); pass 1 sends it out.
     let mut parts: Vec<Part> = (0..np).map(|_| Part::default()).collect();
@@ -260,18 +381,14 @@ pub fn mesh_parallel<C: Comm>(
     // §7 step 3, passes 1 to 3.
     for (j, part_of) in [&part0, &part2, &part3].into_iter().enumerate() {
         let t0 = Instant::now();
-        let walls = Interfaces::new(&d, part_of);
-        let (tets, secs) = parallel_pass(
-            &mut parts,
-            comm,
-            &d,
-            &loc,
-            &walls,
+        let regions = DdgRegions {
+            d: &d,
+            loc: &loc,
+            walls: Interfaces::new(&d, part_of),
             part_of,
-            size,
-            j as u8 + 1,
-            &mut next_gid,
-        )?;
+        };
+        let (tets, secs) =
+            parallel_pass(&mut parts, comm, &regions, size, j as u8 + 1, &mut next_gid)?;
         for (k, &n) in tets.iter().enumerate() {
             made_per_part[k] += n;
         }
@@ -334,23 +451,17 @@ pub fn mesh_parallel<C: Comm>(
 /// box it meets (so that each part knows every face bounding its region);
 /// every part advances its faces; new points get global ids. Returns the
 /// tets and the front seconds of each part.
-#[allow(clippy::too_many_arguments)]
 fn parallel_pass<C: Comm>(
     parts: &mut [Part],
     comm: &C,
-    d: &Ddg,
-    loc: &Locator,
-    walls: &Interfaces,
-    part_of: &[u32],
+    regions: &dyn Regions,
     size: &(dyn Fn(P3) -> f64 + Sync),
     pass: u8,
     next_gid: &mut u32,
 ) -> Result<(Vec<usize>, Vec<f64>), PassError> {
     let np = parts.len();
-    let mut boxes = vec![Aabb::EMPTY; np];
-    for (t, &k) in part_of.iter().enumerate() {
-        boxes[k as usize] = boxes[k as usize].union(&Aabb::from_points(d.tet_points(t).iter()));
-    }
+    let mut boxes = regions.bounds();
+    boxes.resize(np, Aabb::EMPTY);
     let boxes: Vec<Aabb> = boxes
         .iter()
         .map(|b| {
@@ -371,8 +482,7 @@ fn parallel_pass<C: Comm>(
             let mut keep = Vec::new();
             for &f in &part.front {
                 let o = f.map(|i| {
-                    *owner[i as usize]
-                        .get_or_insert_with(|| loc.owner(part.pts[i as usize], part_of))
+                    *owner[i as usize].get_or_insert_with(|| regions.owner(part.pts[i as usize]))
                 });
                 let own = if o[0].is_some() && o[0] == o[1] && o[1] == o[2] {
                     o[0]
@@ -401,7 +511,7 @@ fn parallel_pass<C: Comm>(
     let made: Vec<Made> = inboxes
         .into_par_iter()
         .enumerate()
-        .map(|(k, inbox)| front_call(inbox, k as u32, loc, walls, part_of, size))
+        .map(|(k, inbox)| front_call(inbox, k as u32, regions, size))
         .collect::<Result<_, (usize, FrontError)>>()
         .map_err(|(part, source)| PassError::Pass { pass, part, source })?;
 
@@ -437,9 +547,7 @@ fn parallel_pass<C: Comm>(
 fn front_call(
     inbox: Vec<(u32, FaceMsg)>,
     k: u32,
-    loc: &Locator,
-    walls: &Interfaces,
-    part_of: &[u32],
+    regions: &dyn Regions,
     size: &(dyn Fn(P3) -> f64 + Sync),
 ) -> Result<Made, (usize, FrontError)> {
     let t0 = Instant::now();
@@ -452,6 +560,7 @@ fn front_call(
             seconds: 0.0,
         });
     }
+    let n_owned = inbox.iter().filter(|m| m.1.owned).count();
     // Owned faces first: their points get the low local ids.
     let (input, gids) = local_front(
         [true, false]
@@ -459,39 +568,45 @@ fn front_call(
             .flat_map(|owned| inbox.iter().filter(move |m| m.1.owned == owned))
             .map(|(_, m)| &m.v),
     );
-    let filter = PartFilter {
-        loc,
-        walls,
-        part: part_of,
-        k,
-    };
+    let filter = regions.filter(k);
     let input_ok: Vec<bool> = input
         .points
         .iter()
-        .map(|&p| loc.owner(p, part_of) == Some(k))
+        .map(|&p| regions.owner(p) == Some(k))
         .collect();
     let res = advance(
         input,
         SizeMode::Field(size),
-        &filter,
+        &*filter,
         &FrontOptions {
             pass: true,
             ..FrontOptions::default()
         },
     )
     .map_err(|e| (k as usize, e))?;
+    let t_front = t0.elapsed().as_secs_f64();
     let mut res = res;
     let n_in = gids.len();
-    close_pockets(
+    let pocket_tets = close_pockets(
         &mut res,
         |i| i as usize >= n_in || input_ok[i as usize],
         size,
     );
-    let stuck = res
+    let t_pockets = t0.elapsed().as_secs_f64() - t_front;
+    let stuck: Vec<bool> = res
         .front
         .iter()
-        .map(|f| is_stuck(&res, *f, &filter))
+        .map(|f| is_stuck(&res, *f, &*filter))
         .collect();
+    if std::env::var_os("PARAFRONT_DEBUG_PASSES").is_some() {
+        eprintln!(
+            "part {k}: {} points in, {} owned faces, {} tets, front {t_front:.3} s, pockets {t_pockets:.3} s ({pocket_tets} tets), stuck check {:.3} s",
+            gids.len(),
+            n_owned,
+            res.tets.len(),
+            t0.elapsed().as_secs_f64() - t_front - t_pockets
+        );
+    }
     Ok(Made {
         res: Some(res),
         input_gid: gids,
@@ -686,8 +801,7 @@ fn absorb(part: &mut Part, m: Made, base: u32, pass: u8) -> usize {
 /// Whether face `f` of a pass's result got stuck: the region rules of §7
 /// let the front try it (points and edges inside, the ideal point inside,
 /// computed as the front does), but no tet was accepted.
-fn is_stuck(res: &parafront_front::FrontResult, f: [u32; 3], filter: &PartFilter) -> bool {
-    use parafront_front::RegionFilter;
+fn is_stuck(res: &parafront_front::FrontResult, f: [u32; 3], filter: &dyn RegionFilter) -> bool {
     use parafront_geom::{add, cross, dist, normalize, scale, sub};
     let p = f.map(|i| res.points[i as usize]);
     let inside = p.iter().all(|&q| filter.point_ok(q))

@@ -10,6 +10,7 @@ pub use regions::{material_regions, RegionFront};
 
 use parafront_front::{advance, FrontError, FrontInput, FrontOptions, SizeMode};
 use parafront_mesh::{CheckError, PointId, QualityReport, TetMesh};
+pub use parafront_passes::process_cpu_seconds;
 use parafront_passes::{mesh_parallel, ParOptions, ParStats, PassError, Piece};
 use parafront_size::{SizeError, SizeField, SizeOptions, Sizing};
 use parafront_surface::validate::{validate, Report};
@@ -40,6 +41,10 @@ pub struct MeshOptions {
     /// How the DDG is split into parts (§6): `metis` or `rcb`.
     #[serde(default)]
     pub partition: parafront_ddg::Partition,
+    /// Parallel passes that build the DDG (then a serial pass on what they
+    /// leave); 0 builds it with the serial front; unset takes the default
+    /// (`parafront_passes::DEFAULT_DDG_PASSES`).
+    pub ddg_passes: Option<usize>,
     /// Skip the final validity check (not recommended; it is cheap).
     #[serde(default)]
     pub no_check: bool,
@@ -70,6 +75,7 @@ impl Default for MeshOptions {
             parts: 1,
             ddg_growth: 0.0,
             partition: parafront_ddg::Partition::default(),
+            ddg_passes: None,
             no_check: false,
             debug_partial: false,
             progress: None,
@@ -306,6 +312,9 @@ fn mesh_parts(
             parafront_ddg::DEFAULT_GROWTH
         },
         partition: opts.partition,
+        ddg_passes: opts
+            .ddg_passes
+            .unwrap_or(parafront_passes::DEFAULT_DDG_PASSES),
         ..ParOptions::default()
     };
     let comm = parafront_comm::Threads::new(opts.parts);

@@ -1,0 +1,406 @@
+//! The DDG built by the passes themselves: §5's coarse mesh made with
+//! §7's scheme. No DDG exists yet to cut the domain into regions, so each
+//! parallel pass takes convex cells instead: a recursive bisection of the
+//! front's face centroids into `parts` cells (pass 1 in the coordinate
+//! frame, the later ones in rotated frames, so that their walls cross the
+//! earlier walls instead of lying on them). A cell is convex, so an edge
+//! whose two ends lie inside it stays inside. What the parallel passes
+//! leave is closed by the serial pass of the fine mesher (pass 4).
+//!
+//! The cells follow from the front and `parts` alone, and the passes'
+//! messages are ordered by part: the DDG depends on `parts`, never on the
+//! threads.
+use crate::{parallel_pass, peel_stuck, serial_pass, Part, PassError, Rec, Regions};
+use parafront_comm::Comm;
+use parafront_ddg::{self as ddg, Ddg, DdgMode};
+use parafront_front::RegionFilter;
+use parafront_geom::{dot, Aabb, P3};
+use std::time::Instant;
+
+/// What building the DDG did, pass by pass.
+#[derive(Clone, Debug, Default)]
+pub struct DdgBuildStats {
+    /// Tets made in each parallel pass, then in the serial pass (tets
+    /// peeled later are still counted where they were made).
+    pub pass_tets: Vec<usize>,
+    pub pass_seconds: Vec<f64>,
+    /// The size field (the surface sizes grown by `c - 1` per unit length).
+    pub field_seconds: f64,
+    /// Merging the parts into one mesh and its face neighbours.
+    pub merge_seconds: f64,
+}
+
+#[derive(Clone, Copy, Debug)]
+enum Node {
+    Leaf(u32),
+    Cut {
+        axis: usize,
+        at: f64,
+        lo: u32,
+        hi: u32,
+    },
+}
+
+/// `parts` convex cells: the leaves of a bisection tree in the frame
+/// `rot` (rows: the frame's axes). A point within `margin` of a cut
+/// belongs to no cell.
+pub(crate) struct Cells {
+    rot: [P3; 3],
+    nodes: Vec<Node>,
+    margin: f64,
+    bounds: Vec<Aabb>,
+}
+
+impl Cells {
+    /// Bisects `pts` (equal weights) into `parts` cells, each cut across
+    /// the longest extent of its points in the frame `rot`, halfway
+    /// between the two points on either side of the cut. Deterministic:
+    /// ties go by index. `domain` bounds every point the cells will be
+    /// asked about (for the cells' boxes).
+    pub(crate) fn new(pts: &[P3], parts: usize, rot: [P3; 3], domain: &Aabb) -> Cells {
+        let q: Vec<P3> = pts.iter().map(|&p| rotate(&rot, p)).collect();
+        let mut ids: Vec<u32> = (0..q.len() as u32).collect();
+        // The domain's box in the rotated frame: the box of its corners.
+        let mut rbox = Aabb::EMPTY;
+        for c in corners(domain) {
+            rbox.grow(rotate(&rot, c));
+        }
+        let mut c = Cells {
+            rot,
+            nodes: Vec::new(),
+            margin: 1e-9 * domain.diagonal().max(1e-300),
+            bounds: vec![Aabb::EMPTY; parts],
+        };
+        c.split(&q, &mut ids, 0, parts.max(1) as u32, rbox, domain);
+        c
+    }
+
+    fn split(
+        &mut self,
+        q: &[P3],
+        ids: &mut [u32],
+        first: u32,
+        parts: u32,
+        rbox: Aabb,
+        domain: &Aabb,
+    ) -> u32 {
+        let me = self.nodes.len() as u32;
+        if parts <= 1 || ids.len() < 2 {
+            self.nodes.push(Node::Leaf(first));
+            // The cell's box in the original frame: the rotated box's
+            // corners turned back, clipped to the domain.
+            let mut b = Aabb::EMPTY;
+            for c in corners(&rbox) {
+                b.grow(unrotate(&self.rot, c));
+            }
+            let b = b.inflated(self.margin);
+            self.bounds[first as usize] = Aabb {
+                min: [0, 1, 2].map(|k| b.min[k].max(domain.min[k])),
+                max: [0, 1, 2].map(|k| b.max[k].min(domain.max[k])),
+            };
+            return me;
+        }
+        self.nodes.push(Node::Leaf(first)); // replaced below
+        let ax = Aabb::from_points(ids.iter().map(|&i| &q[i as usize])).longest_axis();
+        ids.sort_unstable_by(|&a, &b| {
+            q[a as usize][ax]
+                .total_cmp(&q[b as usize][ax])
+                .then(a.cmp(&b))
+        });
+        let left = parts / 2;
+        let cut = (ids.len() * left as usize / parts as usize).clamp(1, ids.len() - 1);
+        let at = 0.5 * (q[ids[cut - 1] as usize][ax] + q[ids[cut] as usize][ax]);
+        let (mut lo_box, mut hi_box) = (rbox, rbox);
+        lo_box.max[ax] = at;
+        hi_box.min[ax] = at;
+        let (a, b) = ids.split_at_mut(cut);
+        let lo = self.split(q, a, first, left, lo_box, domain);
+        let hi = self.split(q, b, first + left, parts - left, hi_box, domain);
+        self.nodes[me as usize] = Node::Cut {
+            axis: ax,
+            at,
+            lo,
+            hi,
+        };
+        me
+    }
+}
+
+impl Regions for Cells {
+    fn owner(&self, p: P3) -> Option<u32> {
+        let q = rotate(&self.rot, p);
+        let mut n = 0usize;
+        loop {
+            match self.nodes[n] {
+                Node::Leaf(k) => return Some(k),
+                Node::Cut { axis, at, lo, hi } => {
+                    let d = q[axis] - at;
+                    if d.abs() <= self.margin || d.is_nan() {
+                        return None;
+                    }
+                    n = if d < 0.0 { lo } else { hi } as usize;
+                }
+            }
+        }
+    }
+    fn bounds(&self) -> Vec<Aabb> {
+        self.bounds.clone()
+    }
+    fn filter(&self, k: u32) -> Box<dyn RegionFilter + '_> {
+        Box::new(CellFilter { cells: self, k })
+    }
+}
+
+/// Region filter of one cell: points inside it, off its walls; a cell is
+/// convex, so an edge with both ends inside is inside.
+struct CellFilter<'a> {
+    cells: &'a Cells,
+    k: u32,
+}
+
+impl RegionFilter for CellFilter<'_> {
+    fn point_ok(&self, p: P3) -> bool {
+        self.cells.owner(p) == Some(self.k)
+    }
+    fn edge_ok(&self, a: P3, b: P3) -> bool {
+        self.point_ok(a) && self.point_ok(b)
+    }
+}
+
+fn rotate(r: &[P3; 3], p: P3) -> P3 {
+    [dot(r[0], p), dot(r[1], p), dot(r[2], p)]
+}
+
+fn unrotate(r: &[P3; 3], q: P3) -> P3 {
+    [0, 1, 2].map(|k| r[0][k] * q[0] + r[1][k] * q[1] + r[2][k] * q[2])
+}
+
+fn corners(b: &Aabb) -> [P3; 8] {
+    let mut c = [[0.0; 3]; 8];
+    for (i, x) in c.iter_mut().enumerate() {
+        for (k, xk) in x.iter_mut().enumerate() {
+            *xk = if i >> k & 1 == 0 { b.min[k] } else { b.max[k] };
+        }
+    }
+    c
+}
+
+/// The frame of parallel pass `j`: the coordinate axes for the first, then
+/// rotations about fixed, unrelated axes (Rodrigues), so that no wall of
+/// one pass lies along a wall of another.
+fn frame(j: usize) -> [P3; 3] {
+    const AXES: [(P3, f64); 3] = [
+        ([0.0, 0.0, 1.0], 0.0),
+        ([1.0, 2.0, 3.0], 0.9),
+        ([3.0, -1.0, 2.0], 1.3),
+    ];
+    let (a, angle) = AXES[j % AXES.len()];
+    let n = parafront_geom::normalize(a);
+    let (s, c) = angle.sin_cos();
+    let mut r = [[0.0; 3]; 3];
+    for (i, row) in r.iter_mut().enumerate() {
+        for (k, x) in row.iter_mut().enumerate() {
+            let delta = if i == k { 1.0 } else { 0.0 };
+            // Levi-Civita term of the cross-product matrix.
+            let cross = match (i, k) {
+                (0, 1) => -n[2],
+                (0, 2) => n[1],
+                (1, 0) => n[2],
+                (1, 2) => -n[0],
+                (2, 0) => -n[1],
+                (2, 1) => n[0],
+                _ => 0.0,
+            };
+            *x = c * delta + s * cross + (1.0 - c) * n[i] * n[k];
+        }
+    }
+    r
+}
+
+/// The DDG's surface points get this many times their mean edge length
+/// as their size: the first layer of tets as tall as the front makes them
+/// (at most twice a face's longest edge). §5 multiplies the initial sizes
+/// by `c`; with 2 instead of 1.6 the DDG of sphere_1e6 has 131k tets
+/// instead of 213k (257k at 1), in half the time: tall tets on
+/// neighbouring surface triangles share their apexes.
+pub const FIRST_LAYER: f64 = 2.0;
+
+/// Builds the DDG of the closed front `faces` (normals inward) with
+/// growth `c` (the graded sizes of [`DdgMode::Graded`]): `passes` parallel
+/// passes on `comm.parts()` convex cells each, then the serial pass on
+/// what they left. The sizes are the DDG's own, from the front's edges
+/// (the fine mesh's sizes do not enter).
+pub fn build_ddg<C: Comm>(
+    points: &[P3],
+    faces: &[[u32; 3]],
+    c: f64,
+    passes: usize,
+    comm: &C,
+) -> Result<(Ddg, DdgBuildStats), PassError> {
+    let t_all = Instant::now();
+    let np = comm.parts();
+    let mut st = DdgBuildStats::default();
+    let t0 = Instant::now();
+    let field = ddg::graded_field(points, faces, c)?;
+    st.field_seconds = t0.elapsed().as_secs_f64();
+    let point_size: Vec<f64> = ddg::edge_sizes(points, faces)
+        .iter()
+        .map(|h| FIRST_LAYER * h)
+        .collect();
+    let domain = Aabb::from_points(points.iter());
+    let domain = domain.inflated(1e-6 * domain.diagonal().max(1e-300));
+
+    let mut parts: Vec<Part> = (0..np).map(|_| Part::default()).collect();
+    for f in faces {
+        let v = f.map(|i| {
+            parts[0].local(Rec {
+                gid: i,
+                p: points[i as usize],
+                h: point_size[i as usize],
+            })
+        });
+        parts[0].front.push(v);
+    }
+    let mut next_gid = points.len() as u32;
+    let debug = std::env::var_os("PARAFRONT_DEBUG_PASSES").is_some();
+    for j in 0..passes {
+        let t0 = Instant::now();
+        // The cells split the faces still to advance (an all-gather of
+        // their centroids, in part order).
+        let cen: Vec<P3> = comm
+            .all_gather(
+                parts
+                    .iter()
+                    .map(|p| {
+                        p.front
+                            .iter()
+                            .map(|f| {
+                                let [a, b, c] = f.map(|i| p.pts[i as usize]);
+                                parafront_geom::centroid3(a, b, c)
+                            })
+                            .collect::<Vec<P3>>()
+                    })
+                    .collect(),
+            )
+            .concat();
+        if cen.is_empty() {
+            break;
+        }
+        let cells = Cells::new(&cen, np, frame(j), &domain);
+        let (tets, _) =
+            parallel_pass(&mut parts, comm, &cells, &field, j as u8 + 1, &mut next_gid)?;
+        let peeled = peel_stuck(&mut parts, comm);
+        if debug {
+            let fr: usize = parts.iter().map(|p| p.front.len()).sum();
+            eprintln!(
+                "ddg pass {}: tets {:?}, front left {fr}, {peeled} peeled, {:.3} s",
+                j + 1,
+                tets,
+                t0.elapsed().as_secs_f64()
+            );
+        }
+        st.pass_tets.push(tets.iter().sum());
+        st.pass_seconds.push(t0.elapsed().as_secs_f64());
+    }
+    let t0 = Instant::now();
+    let (made, _) = serial_pass(&mut parts, comm, &field, &mut next_gid)?;
+    if debug {
+        eprintln!(
+            "ddg serial pass: {made} tets, {:.3} s",
+            t0.elapsed().as_secs_f64()
+        );
+    }
+    st.pass_tets.push(made);
+    st.pass_seconds.push(t0.elapsed().as_secs_f64());
+
+    // One mesh: input points first (their ids), then the new points in
+    // global order, those no tet uses left out; tets by part.
+    let t0 = Instant::now();
+    let n = next_gid as usize;
+    let mut at: Vec<P3> = vec![[0.0; 3]; n];
+    let mut used = vec![false; n];
+    used[..points.len()].iter_mut().for_each(|u| *u = true);
+    let mut tets: Vec<[u32; 4]> = Vec::new();
+    for part in &parts {
+        for (i, &g) in part.gid.iter().enumerate() {
+            at[g as usize] = part.pts[i];
+        }
+        for t in &part.tets {
+            let tv = t.map(|i| part.gid[i as usize]);
+            for &g in &tv {
+                used[g as usize] = true;
+            }
+            tets.push(tv);
+        }
+    }
+    drop(parts);
+    let mut map = vec![u32::MAX; n];
+    let mut pts = Vec::with_capacity(n);
+    for g in 0..n {
+        if used[g] {
+            map[g] = pts.len() as u32;
+            pts.push(at[g]);
+        }
+    }
+    for t in &mut tets {
+        *t = t.map(|g| map[g as usize]);
+    }
+    let neigh = ddg::face_neighbours(&tets)
+        .map_err(|e| PassError::Redistribute(format!("the DDG built in parallel: {e}")))?;
+    st.merge_seconds = t0.elapsed().as_secs_f64();
+    Ok((
+        Ddg {
+            points: pts,
+            tets,
+            neigh,
+            n_input: points.len(),
+            growth: c,
+            mode: DdgMode::Graded,
+            seconds: t_all.elapsed().as_secs_f64(),
+        },
+        st,
+    ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn frames_are_rotations() {
+        for j in 0..3 {
+            let r = frame(j);
+            for a in 0..3 {
+                for b in 0..3 {
+                    let want = if a == b { 1.0 } else { 0.0 };
+                    assert!((dot(r[a], r[b]) - want).abs() < 1e-12);
+                }
+            }
+            let p = [0.3, -1.2, 2.5];
+            let back = unrotate(&r, rotate(&r, p));
+            assert!((0..3).all(|k| (back[k] - p[k]).abs() < 1e-12));
+        }
+    }
+
+    #[test]
+    fn cells_split_points_evenly_and_keep_off_their_walls() {
+        let pts: Vec<P3> = (0..1000)
+            .map(|i| {
+                let x = i as f64;
+                [(x * 0.37).sin(), (x * 0.71).cos(), (x * 0.13).sin()]
+            })
+            .collect();
+        let dom = Aabb::from_points(pts.iter()).inflated(0.01);
+        for j in 0..3 {
+            let c = Cells::new(&pts, 8, frame(j), &dom);
+            let mut count = [0usize; 8];
+            for &p in &pts {
+                if let Some(k) = c.owner(p) {
+                    count[k as usize] += 1;
+                    assert!(c.bounds[k as usize].contains(p));
+                }
+            }
+            assert!(count.iter().all(|&n| (110..=126).contains(&n)), "{count:?}");
+        }
+    }
+}
