@@ -38,7 +38,8 @@ use work::Work;
 pub struct ImproveOptions {
     /// 0: off. 1: swaps of tets with mean ratio below 0.4 and two
     /// smoothing passes. 2 (default): swaps below 0.7, edge collapse of
-    /// tets below 0.1, three smoothing passes and selective movement.
+    /// tets below 0.1, three smoothing passes, selective movement and a
+    /// last swap pass below 0.8.
     /// 3: one more smoothing and one more selective pass.
     #[serde(default = "default_level")]
     pub level: u8,
@@ -146,6 +147,14 @@ pub fn improve(
 
 /// Mean ratio under which edge collapse is tried (§9.2).
 const VERY_BAD: f64 = 0.1;
+/// Mean ratio under which the last swap pass of levels 2 and 3 works,
+/// after the smoothing and selective movement have settled the points.
+/// Measured on base_interface_gmsh (a 4.8 mm plate at h = 6.6, where 90 %
+/// of the points are on the surface and swaps are what is left): mean
+/// radius ratio 0.770 -> 0.772 for 0.04 s; 0.75 gives 0.771, 0.85-1.0 no
+/// more than 0.8 for 2-4x the time, and swapping up to 0.9 in every pass
+/// instead gives 0.771 for 5x the time.
+const FINAL_SWAP: f64 = 0.8;
 /// Mean ratio under which the final polish after a parallel run works.
 const POLISH: f64 = 0.5;
 
@@ -183,6 +192,9 @@ pub(crate) fn run(
             imp.selective_pass(bad, st);
             imp.swap_pass(bad, st);
         }
+    }
+    if lv >= 2 {
+        imp.swap_pass(FINAL_SWAP, st);
     }
     Ok(imp.w.compact(drop_points))
 }
