@@ -71,7 +71,8 @@ mod tests {
         // The regular tet: arccos(1/3) at every edge.
         let d = min_dihedral_deg(r);
         assert!((d - (1.0f64 / 3.0).acos().to_degrees()).abs() < 1e-9, "{d}");
-        let flat = [r[0], r[1], r[2], [0.0, 0.0, 0.0]];
+        // The fourth point at the centroid of the first three's face.
+        let flat = [r[0], r[1], r[2], [1.0 / 3.0, 1.0 / 3.0, -1.0 / 3.0]];
         assert!(min_dihedral_deg(flat) < 1e-6);
     }
 }
