@@ -52,6 +52,14 @@ fn positive(p: [P3; 4]) -> bool {
     tet_volume6(p[0], p[1], p[2], p[3]) > 0.0 && orient3d(p[0], p[1], p[2], p[3]) > 0.0
 }
 
+/// How much of the ball's mean mean ratio selective movement may give for
+/// each unit it adds to the ball's worst. Without a limit, selective moves
+/// around the tets under 0.7 pulled skull.obj's mean radius ratio from
+/// 0.826 down to 0.801 (72k points moved); with 0.2 it ends at 0.823,
+/// and base_interface_gmsh keeps the min dihedral the moves buy it (16.5°
+/// against 14.2° without them) at a mean radius ratio of 0.7725, not 0.7717.
+pub(crate) const SELECTIVE_TRADE: f64 = 0.2;
+
 /// Scratch space for the operations, kept between calls.
 #[derive(Default)]
 pub(crate) struct Scratch {
@@ -445,7 +453,8 @@ impl Work<'_> {
 
     /// §9.4 selective movement: try `p` along each of its edges, both ways,
     /// at a few fractions of the edge length; keep the best move if it
-    /// raises the worst quality of the ball.
+    /// raises the worst quality of the ball and the ball's mean quality
+    /// drops by at most [`SELECTIVE_TRADE`] times that gain.
     pub(crate) fn selective_move(&mut self, p: PointId, s: &mut Scratch) -> Outcome {
         if let Some(o) = self.pinned(p) {
             return o;
@@ -458,13 +467,16 @@ impl Work<'_> {
             .map(|&t| self.q[t as usize])
             .fold(f64::INFINITY, f64::min);
         let p0 = self.m.points[p.idx()];
+        let mean0 = ball.iter().map(|&t| self.q[t as usize]).sum::<f64>() / ball.len() as f64;
         let mut best: Option<(f64, P3)> = None;
         for &x in &s.nb {
             let d = parafront_geom::sub(self.m.points[x.idx()], p0);
             for f in [0.25, 0.1, 0.03, -0.03, -0.1, -0.25] {
                 let pos = [0, 1, 2].map(|k| p0[k] + f * d[k]);
-                if let Some((m, _)) = self.ball_quality_at(p, pos, &ball) {
-                    if beats(m, best.map_or(qmin, |b| b.0)) {
+                if let Some((m, mean)) = self.ball_quality_at(p, pos, &ball) {
+                    if beats(m, best.map_or(qmin, |b| b.0))
+                        && mean >= mean0 - SELECTIVE_TRADE * (m - qmin)
+                    {
                         best = Some((m, pos));
                     }
                 }
