@@ -5,7 +5,7 @@
 //! the worst quality of the tets it makes beats the worst of those it
 //! replaces, and every new tet is positive under the exact predicate and
 //! in floating point.
-use crate::quality::quality;
+use crate::quality::{min_dihedral_deg, quality};
 use crate::work::{Work, MAX_RING};
 use parafront_geom::{cross, dist2, norm, orient3d, sub, tet_volume6, P3};
 use parafront_mesh::{PointId, TET_FACES};
@@ -51,6 +51,14 @@ pub(crate) fn beats(new: f64, old: f64) -> bool {
 fn positive(p: [P3; 4]) -> bool {
     tet_volume6(p[0], p[1], p[2], p[3]) > 0.0 && orient3d(p[0], p[1], p[2], p[3]) > 0.0
 }
+
+/// How much of the ball's mean mean ratio selective movement may give for
+/// each unit it adds to the ball's worst. Without a limit, selective moves
+/// around the tets under 0.7 pulled skull.obj's mean radius ratio from
+/// 0.826 down to 0.801 (72k points moved); with 0.2 it ends at 0.823,
+/// and base_interface_gmsh keeps the min dihedral the moves buy it (16.5°
+/// against 14.2° without them) at a mean radius ratio of 0.7725, not 0.7717.
+pub(crate) const SELECTIVE_TRADE: f64 = 0.2;
 
 /// Scratch space for the operations, kept between calls.
 #[derive(Default)]
@@ -445,7 +453,8 @@ impl Work<'_> {
 
     /// §9.4 selective movement: try `p` along each of its edges, both ways,
     /// at a few fractions of the edge length; keep the best move if it
-    /// raises the worst quality of the ball.
+    /// raises the worst quality of the ball and the ball's mean quality
+    /// drops by at most [`SELECTIVE_TRADE`] times that gain.
     pub(crate) fn selective_move(&mut self, p: PointId, s: &mut Scratch) -> Outcome {
         if let Some(o) = self.pinned(p) {
             return o;
@@ -458,13 +467,16 @@ impl Work<'_> {
             .map(|&t| self.q[t as usize])
             .fold(f64::INFINITY, f64::min);
         let p0 = self.m.points[p.idx()];
+        let mean0 = ball.iter().map(|&t| self.q[t as usize]).sum::<f64>() / ball.len() as f64;
         let mut best: Option<(f64, P3)> = None;
         for &x in &s.nb {
             let d = parafront_geom::sub(self.m.points[x.idx()], p0);
             for f in [0.25, 0.1, 0.03, -0.03, -0.1, -0.25] {
                 let pos = [0, 1, 2].map(|k| p0[k] + f * d[k]);
-                if let Some((m, _)) = self.ball_quality_at(p, pos, &ball) {
-                    if beats(m, best.map_or(qmin, |b| b.0)) {
+                if let Some((m, mean)) = self.ball_quality_at(p, pos, &ball) {
+                    if beats(m, best.map_or(qmin, |b| b.0))
+                        && mean >= mean0 - SELECTIVE_TRADE * (m - qmin)
+                    {
                         best = Some((m, pos));
                     }
                 }
@@ -476,6 +488,110 @@ impl Work<'_> {
                 Outcome::Done
             }
             None => Outcome::NotBetter,
+        };
+        s.ball = ball;
+        out
+    }
+
+    /// The last polish for the min dihedral (§9.4's selective movement,
+    /// by a compass search): moves free point `p` to raise the smallest
+    /// dihedral angle of its ball, while no tet inverts and the ball's
+    /// worst mean ratio stays above `keep` times what it was and no more
+    /// of its tets are under 10°. Caps (a
+    /// surface triangle with an angle near 180° and a free apex) sit where
+    /// the mean ratio is best but their dihedral is not: on skull.obj a
+    /// tenth of the worst mean ratio buys 0.14° -> 0.22°.
+    pub(crate) fn dihedral_move(&mut self, p: PointId, keep: f64, s: &mut Scratch) -> Outcome {
+        if let Some(o) = self.pinned(p) {
+            return o;
+        }
+        let mut ball = std::mem::take(&mut s.ball);
+        self.ball(p, &mut ball);
+        self.neighbours(p, &ball, &mut s.nb);
+        let floor = keep
+            * ball
+                .iter()
+                .map(|&t| self.q[t as usize])
+                .fold(f64::INFINITY, f64::min);
+        // (min dihedral, tets under 10°) of the ball with p at pos, when no
+        // tet inverts or falls under the mean ratio floor.
+        let eval = |w: &Self, pos: P3| -> Option<(f64, usize)> {
+            let mut d = f64::INFINITY;
+            let mut under = 0;
+            for &t in &ball {
+                let v = w.m.tets[t as usize];
+                let mut x = w.pts(v);
+                for k in 0..4 {
+                    if v[k] == p {
+                        x[k] = pos;
+                    }
+                }
+                if !positive(x) || quality(x) < floor {
+                    return None;
+                }
+                let dt = min_dihedral_deg(x);
+                d = d.min(dt);
+                under += usize::from(dt < 10.0);
+            }
+            Some((d, under))
+        };
+        let p0 = self.m.points[p.idx()];
+        let len =
+            s.nb.iter()
+                .map(|x| dist2(self.m.points[x.idx()], p0).sqrt())
+                .sum::<f64>()
+                / s.nb.len().max(1) as f64;
+        let Some((d0, under0)) = eval(self, p0) else {
+            s.ball = ball;
+            return Outcome::NotBetter;
+        };
+        const S: f64 = 0.577_350_269_189_625_8;
+        const DIRS: [P3; 14] = [
+            [1.0, 0.0, 0.0],
+            [-1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, -1.0, 0.0],
+            [0.0, 0.0, 1.0],
+            [0.0, 0.0, -1.0],
+            [S, S, S],
+            [-S, -S, -S],
+            [S, -S, S],
+            [-S, S, -S],
+            [S, S, -S],
+            [-S, -S, S],
+            [-S, S, S],
+            [S, -S, -S],
+        ];
+        let (mut best, mut pos) = (d0, p0);
+        let mut step = 0.1 * len;
+        for _ in 0..60 {
+            if step < 1e-3 * len {
+                break;
+            }
+            let mut moved = None;
+            for dir in DIRS {
+                let c = [0, 1, 2].map(|k| pos[k] + step * dir[k]);
+                // No more tets under 10° than before: the share under 10°
+                // is the other criterion.
+                if let Some((d, _)) = eval(self, c).filter(|e| e.1 <= under0) {
+                    if d > moved.map_or(best, |m: (f64, P3)| m.0) + 1e-9 {
+                        moved = Some((d, c));
+                    }
+                }
+            }
+            match moved {
+                Some((d, c)) => {
+                    best = d;
+                    pos = c;
+                }
+                None => step *= 0.5,
+            }
+        }
+        let out = if best > d0 * (1.0 + MARGIN) + 1e-9 {
+            self.commit_move(p, pos, &ball);
+            Outcome::Done
+        } else {
+            Outcome::NotBetter
         };
         s.ball = ball;
         out

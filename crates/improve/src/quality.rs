@@ -22,6 +22,30 @@ pub fn quality(p: [P3; 4]) -> f64 {
     }
 }
 
+/// The smallest dihedral angle of a tet, in degrees (the other
+/// measure). Only the last polish uses it, on the few tets whose worst
+/// dihedral is far below what their mean ratio says (caps on a surface
+/// triangle with an angle near 180°).
+pub fn min_dihedral_deg(p: [P3; 4]) -> f64 {
+    use parafront_geom::{cross, dot, norm, sub};
+    const E: [[usize; 4]; 6] = [
+        [0, 1, 2, 3],
+        [0, 2, 1, 3],
+        [0, 3, 1, 2],
+        [1, 2, 0, 3],
+        [1, 3, 0, 2],
+        [2, 3, 0, 1],
+    ];
+    let mut m = f64::INFINITY;
+    for [a, b, c, d] in E {
+        let e = sub(p[b], p[a]);
+        let n1 = cross(e, sub(p[c], p[a]));
+        let n2 = cross(e, sub(p[d], p[a]));
+        m = m.min(norm(cross(n1, n2)).atan2(dot(n1, n2)));
+    }
+    m.to_degrees()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -44,5 +68,11 @@ mod tests {
             [-1.0, -1.0, 1.0],
         ];
         assert!((quality(r).abs() - 1.0).abs() < 1e-12);
+        // The regular tet: arccos(1/3) at every edge.
+        let d = min_dihedral_deg(r);
+        assert!((d - (1.0f64 / 3.0).acos().to_degrees()).abs() < 1e-9, "{d}");
+        // The fourth point at the centroid of the first three's face.
+        let flat = [r[0], r[1], r[2], [1.0 / 3.0, 1.0 / 3.0, -1.0 / 3.0]];
+        assert!(min_dihedral_deg(flat) < 1e-6);
     }
 }

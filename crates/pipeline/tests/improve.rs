@@ -2,7 +2,8 @@
 //! the surface and the volume stay exactly as they were, the tail of poor
 //! tets shrinks, the worst tet gets no worse, and the result is
 //! deterministic.
-use parafront_improve::{improve, ImproveOptions};
+use parafront_improve::{improve, ImproveOptions, Improver, Outcome};
+use parafront_mesh::quality::{mean_ratio, TET_EDGES};
 use parafront_mesh::{QualityReport, TetMesh};
 use parafront_pipeline::{mesh_surface, MeshOptions};
 use parafront_surface::{generate, Surface};
@@ -140,4 +141,49 @@ fn parallel_parts_are_valid_and_independent_of_threads() {
         100.0 * q.share_min_dihedral_below
     );
     assert!(q.radius_ratio.mean >= qs.radius_ratio.mean - 0.005);
+}
+
+#[test]
+fn a_thin_plate_has_no_swap_left_under_mean_ratio_08() {
+    // Like base_interface_gmsh: a plate one size thick, where most points
+    // are on the surface and, once smoothing has settled, swaps are what
+    // is left. The last swap pass of the default level works up to mean
+    // ratio 0.8 (the others up to 0.7), so no face swap or edge removal
+    // around a tet under 0.8 raises its worst tet any more.
+    let s = generate::voxels([0.0; 3], 1.0, [16, 10, 1], |_, _, _| true);
+    let m0 = front_mesh(&s);
+    let frozen = vec![true; s.points.len()];
+    let mut m = m0.clone();
+    improve(&mut m, &frozen, &ImproveOptions::default()).unwrap();
+    m.check_against_surface(&s.tris).unwrap();
+    let (v0, v) = (m0.volume(), m.volume());
+    assert!((v - v0).abs() <= 1e-12 * v0);
+    let (q0, q) = (QualityReport::new(&m0), QualityReport::new(&m));
+    println!(
+        "thin plate: {} -> {} tets; min dihedral {:.2} -> {:.2}; mean radius ratio {:.4} -> {:.4}",
+        m0.tets.len(),
+        m.tets.len(),
+        q0.min_dihedral.min,
+        q.min_dihedral.min,
+        q0.radius_ratio.mean,
+        q.radius_ratio.mean
+    );
+    assert!(q.min_dihedral.min >= q0.min_dihedral.min);
+    let n = m.tets.len() as u32;
+    let mut imp = Improver::new(&mut m, &frozen).unwrap();
+    let mut left = 0;
+    for t in 0..n {
+        let v = imp.mesh().tets[t as usize];
+        if mean_ratio(v.map(|p| imp.mesh().points[p.idx()])) >= 0.8 {
+            continue;
+        }
+        for f in 0..4 {
+            left += usize::from(imp.swap_face(t, f) == Outcome::Done);
+        }
+        let v = imp.mesh().tets[t as usize];
+        for e in TET_EDGES {
+            left += usize::from(imp.remove_edge(t, v[e[0]], v[e[1]]) == Outcome::Done);
+        }
+    }
+    assert_eq!(left, 0, "swaps left under mean ratio 0.8");
 }
