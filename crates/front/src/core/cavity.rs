@@ -189,12 +189,7 @@ impl<'a> Front<'a> {
                 self.unlink_tet(t);
             }
             self.stats.tets_removed += dead.len();
-            let next = pocket
-                .iter()
-                .copied()
-                .chain(before as u32..self.fv.len() as u32)
-                .find(|&f| self.falive[f as usize]);
-            match next {
+            match self.first_alive(&pocket, before as u32) {
                 Some(f) => seed = f,
                 None => return Pocket::Failed,
             }
@@ -248,12 +243,7 @@ impl<'a> Front<'a> {
         if take.is_empty() {
             return Pocket::Failed;
         }
-        let id = self.pts.len() as u32;
-        self.commit(take[0], NONE, p);
-        for &f in &take[1..] {
-            self.commit(f, id, p);
-        }
-        self.stats.pockets_filled += 1;
+        self.commit_cone(&take, p);
         Pocket::Partial
     }
 
@@ -276,12 +266,7 @@ impl<'a> Front<'a> {
                 break;
             }
             made = true;
-            let next = cur
-                .iter()
-                .copied()
-                .chain(before..self.fv.len() as u32)
-                .find(|&f| self.falive[f as usize]);
-            let Some(seed) = next else {
+            let Some(seed) = self.first_alive(&cur, before) else {
                 return Pocket::Filled;
             };
             cur = self.pocket(seed);
@@ -299,15 +284,20 @@ impl<'a> Front<'a> {
         }
     }
 
-    /// The deepest point over the planes of `faces`, kept inside `bb`.
-    fn deepest_over(&self, faces: &[u32], bb: &Aabb) -> Option<(P3, f64)> {
-        let mut planes: Vec<(P3, P3)> = faces
+    /// Each face's plane: a corner and the normal into the pocket.
+    fn face_planes(&self, faces: &[u32]) -> Vec<(P3, P3)> {
+        faces
             .iter()
             .map(|&f| {
                 let [a, b, d] = self.fv[f as usize].map(|i| self.pts[i as usize]);
                 (a, tri_normal(a, b, d))
             })
-            .collect();
+            .collect()
+    }
+
+    /// The deepest point over the planes of `faces`, kept inside `bb`.
+    fn deepest_over(&self, faces: &[u32], bb: &Aabb) -> Option<(P3, f64)> {
+        let mut planes = self.face_planes(faces);
         for k in 0..3 {
             let mut n = [0.0; 3];
             n[k] = 1.0;
@@ -343,12 +333,7 @@ impl<'a> Front<'a> {
         if take.is_empty() {
             return false;
         }
-        let id = self.pts.len() as u32;
-        self.commit(take[0], NONE, x);
-        for &f in &take[1..] {
-            self.commit(f, id, x);
-        }
-        self.stats.pockets_filled += 1;
+        self.commit_cone(&take, x);
         true
     }
 
@@ -521,10 +506,7 @@ impl<'a> Front<'a> {
                     let before = self.fv.len() as u32;
                     top.tet = self.tets.len() as u32;
                     self.commit(fid, q, p);
-                    faces.retain(|&g| self.falive[g as usize]);
-                    faces.extend(
-                        (before..self.fv.len() as u32).filter(|&g| self.falive[g as usize]),
-                    );
+                    self.refresh(&mut faces, before);
                     placed = true;
                     break;
                 }
@@ -558,10 +540,7 @@ impl<'a> Front<'a> {
                     let before = self.fv.len() as u32;
                     self.talive[t as usize] = false;
                     self.unlink_tet(t);
-                    faces.retain(|&g| self.falive[g as usize]);
-                    faces.extend(
-                        (before..self.fv.len() as u32).filter(|&g| self.falive[g as usize]),
-                    );
+                    self.refresh(&mut faces, before);
                 }
                 _ => return false,
             }
@@ -625,13 +604,7 @@ impl<'a> Front<'a> {
         }
         // The kernel's deepest point (exact LP): thin pockets have kernels
         // far smaller than the pattern search's first step.
-        let planes: Vec<(P3, P3)> = pocket
-            .iter()
-            .map(|&f| {
-                let [a, b, d] = self.fv[f as usize].map(|i| self.pts[i as usize]);
-                (a, tri_normal(a, b, d))
-            })
-            .collect();
+        let planes = self.face_planes(pocket);
         if let Some((x, depth)) = parafront_geom::kernel::deepest_point(&planes) {
             if depth > 0.0 {
                 cands.push(x);
@@ -691,6 +664,22 @@ impl<'a> Front<'a> {
         let (mut near_f, mut near_p) = (Vec::new(), Vec::new());
         self.gather(&bb, f, &mut near_f, &mut near_p);
         self.tet_is_free(v, q, p, &near_f, &near_p, cl)
+    }
+
+    /// The first live face of `faces`, then of those made since `before`.
+    fn first_alive(&self, faces: &[u32], before: u32) -> Option<u32> {
+        faces
+            .iter()
+            .copied()
+            .chain(before..self.fv.len() as u32)
+            .find(|&f| self.falive[f as usize])
+    }
+
+    /// `faces` after a commit or an undo: the live ones, and those made
+    /// since `before`.
+    fn refresh(&self, faces: &mut Vec<u32>, before: u32) {
+        faces.retain(|&g| self.falive[g as usize]);
+        faces.extend((before..self.fv.len() as u32).filter(|&g| self.falive[g as usize]));
     }
 
     fn commit_cone(&mut self, pocket: &[u32], p: P3) {
