@@ -52,10 +52,10 @@ impl GradedField {
     }
 
     /// The seeds of a closed front: its points, each with the mean length
-    /// of its edges ([`edge_sizes`], what the fine size field gives a
+    /// of its edges ([`parafront_surface::mean_edge_lengths`], what the fine size field gives a
     /// surface point).
     pub fn of_front(points: &[P3], faces: &[[u32; 3]], slope: f64) -> GradedField {
-        let h = edge_sizes(points, faces);
+        let h = parafront_surface::mean_edge_lengths(points, faces);
         let seeds = (0..points.len())
             .filter(|&i| h[i] > 0.0)
             .map(|i| (points[i], h[i]))
@@ -105,27 +105,6 @@ impl GradedField {
         }
         nd.hmin + self.slope * d2.sqrt()
     }
-}
-
-/// Per point of the front `faces`, the mean length of its edges (0 for a
-/// point on none).
-pub fn edge_sizes(points: &[P3], faces: &[[u32; 3]]) -> Vec<f64> {
-    let mut sum = vec![0.0; points.len()];
-    let mut n = vec![0u32; points.len()];
-    for f in faces {
-        for k in 0..3 {
-            let (a, b) = (f[k] as usize, f[(k + 1) % 3] as usize);
-            let l = dist(points[a], points[b]);
-            sum[a] += l;
-            sum[b] += l;
-            n[a] += 1;
-            n[b] += 1;
-        }
-    }
-    sum.iter()
-        .zip(&n)
-        .map(|(s, &n)| if n > 0 { s / n as f64 } else { 0.0 })
-        .collect()
 }
 
 /// Median split across the longest axis; deterministic (ties by the

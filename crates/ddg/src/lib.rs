@@ -8,7 +8,7 @@ mod field;
 mod locate;
 mod partition;
 
-pub use field::{edge_sizes, GradedField};
+pub use field::GradedField;
 
 pub use locate::{Interfaces, Locator, PartFilter};
 pub use partition::{

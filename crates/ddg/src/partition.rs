@@ -360,8 +360,8 @@ mod tests {
     use super::*;
     use parafront_surface::generate;
 
-    fn sphere_ddg() -> Ddg {
-        let s = generate::icosphere([0.0; 3], 1.0, 3);
+    /// The DDG of a closed surface (its front: the triangles reversed).
+    fn ddg_of(s: &parafront_surface::Surface) -> Ddg {
         let faces: Vec<[u32; 3]> = s.tris.iter().map(|t| [t[0], t[2], t[1]]).collect();
         crate::build(
             s.points.clone(),
@@ -371,6 +371,10 @@ mod tests {
             crate::DdgMode::default(),
         )
         .unwrap()
+    }
+
+    fn sphere_ddg() -> Ddg {
+        ddg_of(&generate::icosphere([0.0; 3], 1.0, 3))
     }
 
     #[test]
@@ -389,16 +393,7 @@ mod tests {
     }
 
     fn torus_ddg() -> Ddg {
-        let s = generate::torus([0.0; 3], 1.0, 0.4, 48, 20);
-        let faces: Vec<[u32; 3]> = s.tris.iter().map(|t| [t[0], t[2], t[1]]).collect();
-        crate::build(
-            s.points.clone(),
-            s.mean_edge_lengths(),
-            faces,
-            crate::DEFAULT_GROWTH,
-            crate::DdgMode::default(),
-        )
-        .unwrap()
+        ddg_of(&generate::torus([0.0; 3], 1.0, 0.4, 48, 20))
     }
 
     #[test]

@@ -10,7 +10,7 @@
 //! The cells follow from the front and `parts` alone, and the passes'
 //! messages are ordered by part: the DDG depends on `parts`, never on the
 //! threads.
-use crate::{parallel_pass, peel_stuck, serial_pass, Part, PassError, Rec, Regions};
+use crate::{parallel_pass, peel_stuck, seed_parts, serial_pass, PassError, Regions};
 use parafront_comm::Comm;
 use parafront_ddg::{self as ddg, Ddg, DdgMode};
 use parafront_front::RegionFilter;
@@ -243,24 +243,14 @@ pub fn build_ddg<C: Comm>(
     let t0 = Instant::now();
     let field = ddg::graded_field(points, faces, c)?;
     st.field_seconds = t0.elapsed().as_secs_f64();
-    let point_size: Vec<f64> = ddg::edge_sizes(points, faces)
+    let point_size: Vec<f64> = parafront_surface::mean_edge_lengths(points, faces)
         .iter()
         .map(|h| FIRST_LAYER * h)
         .collect();
     let domain = Aabb::from_points(points.iter());
     let domain = domain.inflated(1e-6 * domain.diagonal().max(1e-300));
 
-    let mut parts: Vec<Part> = (0..np).map(|_| Part::default()).collect();
-    for f in faces {
-        let v = f.map(|i| {
-            parts[0].local(Rec {
-                gid: i,
-                p: points[i as usize],
-                h: point_size[i as usize],
-            })
-        });
-        parts[0].front.push(v);
-    }
+    let mut parts = seed_parts(np, points, &point_size, faces);
     let mut next_gid = points.len() as u32;
     let debug = std::env::var_os("PARAFRONT_DEBUG_PASSES").is_some();
     for j in 0..passes {

@@ -192,6 +192,23 @@ struct Part {
     stuck: Vec<u32>,
 }
 
+/// `np` empty parts, the input front on part 0 (the reader); pass 1 sends
+/// it out.
+fn seed_parts(np: usize, points: &[P3], point_size: &[f64], faces: &[[u32; 3]]) -> Vec<Part> {
+    let mut parts: Vec<Part> = (0..np).map(|_| Part::default()).collect();
+    for f in faces {
+        let v = f.map(|i| {
+            parts[0].local(Rec {
+                gid: i,
+                p: points[i as usize],
+                h: point_size[i as usize],
+            })
+        });
+        parts[0].front.push(v);
+    }
+    parts
+}
+
 impl Part {
     fn local(&mut self, r: Rec) -> u32 {
         if let Some(&i) = self.index.get(&r.gid) {
@@ -363,18 +380,7 @@ pub fn mesh_parallel<C: Comm>(
         );
     }
 
-    // The input front starts on part 0 (the reader); pass 1 sends it out.
-    let mut parts: Vec<Part> = (0..np).map(|_| Part::default()).collect();
-    for f in faces {
-        let v = f.map(|i| {
-            parts[0].local(Rec {
-                gid: i,
-                p: points[i as usize],
-                h: point_size[i as usize],
-            })
-        });
-        parts[0].front.push(v);
-    }
+    let mut parts = seed_parts(np, points, point_size, faces);
     let mut next_gid = points.len() as u32;
     let mut made_per_part = vec![0usize; np];
 

@@ -5,6 +5,11 @@ use parafront_mesh::{PointId, TetMesh};
 use parafront_passes::{mesh_parallel, ParOptions, ParOutput, Partition};
 use parafront_surface::{generate, Surface};
 
+/// Coordinates as bits: "the same mesh" means the same floats.
+fn bits(p: &[P3]) -> Vec<[u64; 3]> {
+    p.iter().map(|x| x.map(f64::to_bits)).collect()
+}
+
 fn run(s: &Surface, h: f64, parts: usize) -> ParOutput {
     run_with(s, h, parts, Partition::default())
 }
@@ -155,16 +160,7 @@ fn the_mesh_does_not_depend_on_the_threads() {
     let b = two.install(|| run(&s, h, 4));
     check(&s, &a);
     assert_eq!(a.tets, b.tets);
-    assert_eq!(
-        a.points
-            .iter()
-            .map(|p| p.map(f64::to_bits))
-            .collect::<Vec<_>>(),
-        b.points
-            .iter()
-            .map(|p| p.map(f64::to_bits))
-            .collect::<Vec<_>>()
-    );
+    assert_eq!(bits(&a.points), bits(&b.points));
 }
 
 /// The METIS partition (the default) against coordinate bisection on a
@@ -286,15 +282,6 @@ fn the_ddg_built_in_parallel_is_valid_and_does_not_depend_on_the_threads() {
         assert_eq!(a.n_input, s.points.len());
         assert_eq!(a.points[..a.n_input], s.points[..]);
         assert_eq!(a.tets, b.tets);
-        assert_eq!(
-            a.points
-                .iter()
-                .map(|p| p.map(f64::to_bits))
-                .collect::<Vec<_>>(),
-            b.points
-                .iter()
-                .map(|p| p.map(f64::to_bits))
-                .collect::<Vec<_>>()
-        );
+        assert_eq!(bits(&a.points), bits(&b.points));
     }
 }

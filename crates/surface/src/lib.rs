@@ -44,25 +44,9 @@ impl Surface {
         parafront_geom::Aabb::from_points(&self.points)
     }
     /// Mean length of the edges at each point (AG3's default size); 0 for
-    /// a point no triangle uses. Interior edges count once per triangle,
-    /// i.e. twice, which leaves the mean unchanged on a closed surface.
+    /// a point no triangle uses ([`mean_edge_lengths`]).
     pub fn mean_edge_lengths(&self) -> Vec<f64> {
-        let mut sum = vec![0.0; self.points.len()];
-        let mut n = vec![0u32; self.points.len()];
-        for t in &self.tris {
-            for k in 0..3 {
-                let (a, b) = (t[k] as usize, t[(k + 1) % 3] as usize);
-                let l = parafront_geom::dist(self.points[a], self.points[b]);
-                sum[a] += l;
-                sum[b] += l;
-                n[a] += 1;
-                n[b] += 1;
-            }
-        }
-        sum.iter()
-            .zip(&n)
-            .map(|(s, &n)| if n > 0 { s / n as f64 } else { 0.0 })
-            .collect()
+        mean_edge_lengths(&self.points, &self.tris)
     }
     /// Signed enclosed volume by the divergence theorem (positive when the
     /// normals point outward).
@@ -78,4 +62,27 @@ impl Surface {
         }
         v / 6.0
     }
+}
+
+/// Mean length of the edges at each point of `tris` (AG3's default size);
+/// 0 for a point no triangle uses. Interior edges count once per triangle,
+/// i.e. twice, which leaves the mean unchanged on a closed surface; the
+/// orientation does not matter.
+pub fn mean_edge_lengths(points: &[parafront_geom::P3], tris: &[[u32; 3]]) -> Vec<f64> {
+    let mut sum = vec![0.0; points.len()];
+    let mut n = vec![0u32; points.len()];
+    for t in tris {
+        for k in 0..3 {
+            let (a, b) = (t[k] as usize, t[(k + 1) % 3] as usize);
+            let l = parafront_geom::dist(points[a], points[b]);
+            sum[a] += l;
+            sum[b] += l;
+            n[a] += 1;
+            n[b] += 1;
+        }
+    }
+    sum.iter()
+        .zip(&n)
+        .map(|(s, &n)| if n > 0 { s / n as f64 } else { 0.0 })
+        .collect()
 }
