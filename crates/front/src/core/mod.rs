@@ -1033,6 +1033,16 @@ impl<'a> Front<'a> {
         };
         let em = EDGE_CLEARANCE * margin;
         let tb_clear = tb.inflated(m_apex.max(em));
+        // The new edges' boxes, grown by the edge clearance: a front edge
+        // whose box misses one is farther than that from the edge.
+        let ebox: [Aabb; 3] = [0, 1, 2].map(|e| {
+            let mut b = Aabb {
+                min: tp[e],
+                max: tp[e],
+            };
+            b.grow(pq);
+            b.inflated(em)
+        });
         for nf in near_f {
             if !nf.bb.overlaps(&tb_clear) {
                 continue;
@@ -1057,6 +1067,9 @@ impl<'a> Front<'a> {
             // only slivers fill (thin plates of CAD needles).
             if em > 0.0 && !planes.clear_of(gp, em) {
                 for e in 0..3 {
+                    if !ebox[e].overlaps(&nf.bb) {
+                        continue;
+                    }
                     let a = tv[e];
                     for k in 0..3 {
                         let (g0, g1) = (g[k], g[(k + 1) % 3]);
@@ -1066,7 +1079,13 @@ impl<'a> Front<'a> {
                         if tv.contains(&g0) && tv.contains(&g1) {
                             continue; // an edge of the tet itself
                         }
-                        if segment_segment_dist2(tp[e], pq, gp[k], gp[(k + 1) % 3]) < em * em {
+                        let (x0, x1) = (gp[k], gp[(k + 1) % 3]);
+                        let mut sb = Aabb { min: x0, max: x0 };
+                        sb.grow(x1);
+                        if !ebox[e].overlaps(&sb) {
+                            continue;
+                        }
+                        if segment_segment_dist2(tp[e], pq, x0, x1) < em * em {
                             return false;
                         }
                     }
