@@ -444,6 +444,9 @@ fn print_summary(sum: &Summary, q: &QualityReport) {
     if front > 0.0 {
         println!("front: {:.0} tets/s", sum.tets as f64 / front);
     }
+    for (r, e) in &sum.serial_fallback {
+        println!("region {r}: the parallel passes failed ({e}); meshed by the serial front");
+    }
     if sum.recovery_rounds > 0 {
         println!(
             "recovery: {} rounds, {} tets removed and re-meshed",

@@ -78,6 +78,12 @@ pub fn write_partitioned(path: &Path, sum: &Summary, w: &WriteOptions) -> Result
     if sum.pieces.is_empty() {
         return Err(Fail(2, "--pvtu needs --parts > 1".into()));
     }
+    if let Some((r, _)) = sum.serial_fallback.first() {
+        return Err(Fail(
+            1,
+            format!("--pvtu: region {r} was meshed by the serial front (its passes failed), so there is no partitioned mesh to write"),
+        ));
+    }
     struct Arrays {
         mesh: TetMesh,
         gid: Vec<i64>,

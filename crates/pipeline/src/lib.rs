@@ -11,7 +11,8 @@ pub use regions::{material_regions, RegionFront};
 use parafront_front::{advance, FrontError, FrontInput, FrontOptions, SizeMode};
 use parafront_mesh::{CheckError, PointId, QualityReport, TetMesh};
 pub use parafront_passes::process_cpu_seconds;
-use parafront_passes::{mesh_parallel, ParOptions, ParStats, PassError, Piece};
+use parafront_ddg::DdgError;
+use parafront_passes::{mesh_parallel, ParOptions, ParOutput, ParStats, PassError, Piece};
 use parafront_size::{SizeError, SizeField, SizeOptions, Sizing};
 use parafront_surface::validate::{validate, Report};
 use parafront_surface::Surface;
@@ -114,6 +115,9 @@ pub struct Summary {
     pub stages: Vec<(&'static str, f64)>,
     pub recovery_rounds: u32,
     pub tets_removed: usize,
+    /// Regions (ids as in the mesh) the parallel passes could not close,
+    /// meshed by the serial front instead, with the passes' error.
+    pub serial_fallback: Vec<(usize, String)>,
     /// Quality of the front's mesh before improvement (when it ran).
     pub quality_before: Option<QualityReport>,
     /// What improvement did, per operation (when it ran).
@@ -220,32 +224,45 @@ fn mesh_serial(
     mesh: &mut TetMesh,
     sum: &mut Summary,
 ) -> Result<(), MeshError> {
-    let field = |p| sizing.size(p);
-    for (r, rf) in fronts.iter().enumerate() {
-        let (points, point_size) = region_points(s, sizing, rf);
-        let input = FrontInput {
-            points,
-            point_size,
-            faces: rf.faces.clone(),
-        };
-        let res = advance(
-            input,
-            SizeMode::Field(&field),
-            &parafront_front::Everywhere,
-            &FrontOptions {
-                progress: opts.progress.clone(),
-                keep_partial: opts.debug_partial,
-                ..FrontOptions::default()
-            },
-        )
-        .map_err(|e| MeshError::Front {
-            region: r,
-            source: e,
-        })?;
-        append_region(mesh, rf, &res.points, &res.tets);
-        sum.recovery_rounds += res.stats.recovery_rounds;
-        sum.tets_removed += res.stats.tets_removed;
+    for rf in fronts {
+        serial_region(s, rf, sizing, opts, mesh, sum)?;
     }
+    Ok(())
+}
+
+/// The serial front on region `r`, appended to `mesh`.
+fn serial_region(
+    s: &Surface,
+    rf: &RegionFront,
+    sizing: &Sizing,
+    opts: &MeshOptions,
+    mesh: &mut TetMesh,
+    sum: &mut Summary,
+) -> Result<(), MeshError> {
+    let field = |p| sizing.size(p);
+    let (points, point_size) = region_points(s, sizing, rf);
+    let input = FrontInput {
+        points,
+        point_size,
+        faces: rf.faces.clone(),
+    };
+    let res = advance(
+        input,
+        SizeMode::Field(&field),
+        &parafront_front::Everywhere,
+        &FrontOptions {
+            progress: opts.progress.clone(),
+            keep_partial: opts.debug_partial,
+            ..FrontOptions::default()
+        },
+    )
+    .map_err(|e| MeshError::Front {
+        region: rf.region_id as usize,
+        source: e,
+    })?;
+    append_region(mesh, rf, &res.points, &res.tets);
+    sum.recovery_rounds += res.stats.recovery_rounds;
+    sum.tets_removed += res.stats.tets_removed;
     Ok(())
 }
 
@@ -303,6 +320,19 @@ fn mesh_parts(
     mesh: &mut TetMesh,
     sum: &mut Summary,
 ) -> Result<(), MeshError> {
+    mesh_parts_with(s, fronts, sizing, opts, mesh, sum, mesh_parallel)
+}
+
+/// [`mesh_parts`] with the parallel mesher given (tests make it fail).
+fn mesh_parts_with(
+    s: &Surface,
+    fronts: &[RegionFront],
+    sizing: &Sizing,
+    opts: &MeshOptions,
+    mesh: &mut TetMesh,
+    sum: &mut Summary,
+    parallel: ParallelMesher,
+) -> Result<(), MeshError> {
     let field = |p| sizing.size(p);
     let popts = ParOptions {
         parts: opts.parts,
@@ -319,14 +349,31 @@ fn mesh_parts(
     };
     let comm = parafront_comm::Threads::new(opts.parts);
     let mut stage = [0.0f64; 7];
-    for (r, rf) in fronts.iter().enumerate() {
+    for rf in fronts {
         let (pts, hs) = region_points(s, sizing, rf);
-        let out = mesh_parallel(&pts, &hs, &rf.faces, &field, &popts, &comm).map_err(|e| {
-            MeshError::Parallel {
-                region: r,
-                source: e,
+        let t_par = Instant::now();
+        let out = match parallel(&pts, &hs, &rf.faces, &field, &popts, &comm) {
+            Ok(out) => out,
+            // A valid surface must not fail (AF5, step 4): a front the
+            // passes leave unclosable (CAD needles next to a part wall) gets
+            // the serial front, which recovers from the input surface.
+            Err(e @ (PassError::Pass { .. } | PassError::Ddg(DdgError::Front(_)))) => {
+                tracing::warn!(region = rf.region_id, "parallel passes failed ({e}); meshing serially");
+                sum.serial_fallback.push((rf.region_id as usize, e.to_string()));
+                sum.stages
+                    .push(("failed passes", t_par.elapsed().as_secs_f64()));
+                let t0 = Instant::now();
+                serial_region(s, rf, sizing, opts, mesh, sum)?;
+                sum.stages.push(("front", t0.elapsed().as_secs_f64()));
+                continue;
             }
-        })?;
+            Err(e) => {
+                return Err(MeshError::Parallel {
+                    region: rf.region_id as usize,
+                    source: e,
+                })
+            }
+        };
         let base = append_region(mesh, rf, &out.points, &out.tets);
         let st = &out.stats;
         for (k, x) in [
@@ -368,11 +415,78 @@ fn mesh_parts(
     Ok(())
 }
 
+type ParallelMesher = fn(
+    &[parafront_geom::P3],
+    &[f64],
+    &[[u32; 3]],
+    &(dyn Fn(parafront_geom::P3) -> f64 + Sync),
+    &ParOptions,
+    &parafront_comm::Threads,
+) -> Result<ParOutput, PassError>;
+
 /// Quality of `mesh` with edge lengths measured against the size field
 /// the run used.
 pub fn quality_report(mesh: &TetMesh, s: &Surface, opts: &MeshOptions) -> QualityReport {
     match Sizing::build(s, &opts.size, None) {
         Ok(sz) => QualityReport::with_size(mesh, |p| sz.size(p)),
         Err(_) => QualityReport::new(mesh),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use parafront_surface::generate;
+
+    /// A pass that cannot close its front must not fail the run: the
+    /// region goes to the serial front, and the summary says so.
+    #[test]
+    fn failed_passes_fall_back_to_the_serial_front() {
+        fn stuck(
+            _: &[parafront_geom::P3],
+            _: &[f64],
+            _: &[[u32; 3]],
+            _: &(dyn Fn(parafront_geom::P3) -> f64 + Sync),
+            _: &ParOptions,
+            _: &parafront_comm::Threads,
+        ) -> Result<ParOutput, PassError> {
+            Err(PassError::Pass {
+                pass: 4,
+                part: 0,
+                source: FrontError::Stuck {
+                    rounds: 60,
+                    faces: 12,
+                    x: 0.0,
+                    y: 0.0,
+                    z: 0.0,
+                    partial: None,
+                },
+            })
+        }
+        let s = generate::torus([0.0; 3], 2.0, 0.7, 24, 12);
+        let report = validate(&s);
+        assert!(report.is_valid());
+        let fronts = material_regions(&s, &report.shells);
+        let opts = MeshOptions {
+            parts: 4,
+            ..MeshOptions::default()
+        };
+        let sizing = Sizing::build(&s, &opts.size, None).unwrap();
+        let mut mesh = TetMesh {
+            points: s.points.clone(),
+            bnd_tris: s.tris.iter().map(|t| t.map(PointId)).collect(),
+            bnd_patch: s.patch.clone(),
+            ..Default::default()
+        };
+        let mut sum = Summary::default();
+        mesh_parts_with(&s, &fronts, &sizing, &opts, &mut mesh, &mut sum, stuck).unwrap();
+        assert_eq!(sum.serial_fallback.len(), 1);
+        assert_eq!(sum.serial_fallback[0].0, 1);
+        assert!(sum.serial_fallback[0].1.contains("pass 4"));
+        assert!(sum.parallel.is_empty());
+        mesh.build_adjacency().unwrap();
+        mesh.check_against_surface(&s.tris).unwrap();
+        let v = mesh.volume();
+        assert!((v - s.signed_volume()).abs() < 1e-9 * v, "{v}");
     }
 }
