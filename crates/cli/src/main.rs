@@ -28,7 +28,7 @@ struct Cli {
 #[derive(Subcommand)]
 enum Cmd {
     /// Mesh the built-in demo part (a block with a drilled hole, a void
-    /// and an embedded torus) and write it.
+    /// and an embedded sphere, its own region) and write it.
     Demo {
         /// Output mesh (.vtu, .msh, .mesh).
         #[arg(short, long, default_value = "demo.vtu")]
@@ -117,6 +117,10 @@ struct MeshArgs {
     /// Worker threads (default: all cores).
     #[arg(long)]
     threads: Option<usize>,
+    /// Mesh inner bodies (inner shells with outward normals) as regions
+    /// of their own; without it every inner shell is a void.
+    #[arg(long)]
+    regions: bool,
     /// Parts of the parallel mesher (the paper's nproc; 1: serial front).
     #[arg(long, default_value_t = 1)]
     parts: usize,
@@ -192,6 +196,9 @@ fn main() -> ExitCode {
             if check_only {
                 run_demo_check(&s, &output, &write)
             } else {
+                // The embedded sphere is the demo's second region.
+                let mut mesh = mesh;
+                mesh.regions = true;
                 run_mesh(&s, "demo part", &output, &mesh, &write)
             }
         }
@@ -263,6 +270,7 @@ fn mesh_options(a: &MeshArgs) -> Result<MeshOptions, Fail> {
         o.size.gradation = v;
     }
     o.threads = a.threads.unwrap_or(0);
+    o.regions = a.regions;
     o.debug_partial = a.debug_dump.is_some();
     if let Some(l) = a.optimize {
         o.optimize = l;
@@ -443,6 +451,15 @@ fn print_summary(sum: &Summary, q: &QualityReport) {
     );
     if front > 0.0 {
         println!("front: {:.0} tets/s", sum.tets as f64 / front);
+    }
+    if !sum.voided_shells.is_empty() {
+        let ids: Vec<String> = sum.voided_shells.iter().map(|k| k.to_string()).collect();
+        println!(
+            "inner shell{} {} (outward normals) meshed as void{}; --regions meshes inner bodies as regions",
+            if ids.len() == 1 { "" } else { "s" },
+            ids.join(", "),
+            if ids.len() == 1 { "" } else { "s" }
+        );
     }
     for (r, e) in &sum.serial_fallback {
         println!("region {r}: the parallel passes failed ({e}); meshed by the serial front");

@@ -14,7 +14,7 @@ pub use parafront_passes::process_cpu_seconds;
 use parafront_ddg::DdgError;
 use parafront_passes::{mesh_parallel, ParOptions, ParOutput, ParStats, PassError, Piece};
 use parafront_size::{SizeError, SizeField, SizeOptions, Sizing};
-use parafront_surface::validate::{validate, Report};
+use parafront_surface::validate::{validate, Report, Shell, ShellKind};
 use parafront_surface::Surface;
 use serde::{Deserialize, Serialize};
 use std::time::Instant;
@@ -57,6 +57,10 @@ pub struct MeshOptions {
     /// a file can set).
     #[serde(skip)]
     pub progress: Option<std::sync::Arc<parafront_front::Progress>>,
+    /// Inner bodies (shells inside material with outward normals) become
+    /// regions of their own; without it every inner shell is a void.
+    #[serde(default)]
+    pub regions: bool,
     /// Mesh improvement level (§9): 0 off, 1 swaps and smoothing, 2
     /// (default) also collapse of very bad tets and selective movement, 3
     /// more passes. See `parafront_improve::ImproveOptions`.
@@ -81,6 +85,7 @@ impl Default for MeshOptions {
             debug_partial: false,
             progress: None,
             optimize: default_optimize(),
+            regions: false,
         }
     }
 }
@@ -115,6 +120,9 @@ pub struct Summary {
     pub stages: Vec<(&'static str, f64)>,
     pub recovery_rounds: u32,
     pub tets_removed: usize,
+    /// Shells (ids as `parafront check` prints them) oriented as inner
+    /// bodies and meshed as voids, without `regions`.
+    pub voided_shells: Vec<usize>,
     /// Regions (ids as in the mesh) the parallel passes could not close,
     /// meshed by the serial front instead, with the passes' error.
     pub serial_fallback: Vec<(usize, String)>,
@@ -148,10 +156,35 @@ impl Summary {
 pub fn mesh_surface(s: &Surface, opts: &MeshOptions) -> Result<(TetMesh, Summary), MeshError> {
     let mut sum = Summary::default();
     let t0 = Instant::now();
-    let report = validate(s);
+    let mut report = validate(s);
     if !report.is_valid() {
         return Err(MeshError::InvalidSurface(Box::new(report)));
     }
+    // Inner shells are voids unless asked for regions: such a shell's
+    // triangles are turned round, and the mesh keeps them so.
+    let voided = if opts.regions {
+        Vec::new()
+    } else {
+        bodies_in_material(&report.shells)
+    };
+    let turned;
+    let s = if voided.is_empty() {
+        s
+    } else {
+        let mut t = s.clone();
+        for &k in &voided {
+            for &f in &report.shells[k].tris {
+                t.tris[f as usize].swap(1, 2);
+            }
+        }
+        report = validate(&t);
+        if !report.is_valid() {
+            return Err(MeshError::InvalidSurface(Box::new(report)));
+        }
+        turned = t;
+        &turned
+    };
+    sum.voided_shells = voided;
     let fronts = material_regions(s, &report.shells);
     sum.stages.push(("validate", t0.elapsed().as_secs_f64()));
 
@@ -213,6 +246,31 @@ pub fn mesh_surface(s: &Surface, opts: &MeshOptions) -> Result<(TetMesh, Summary
     sum.points = mesh.points.len();
     sum.regions = fronts.len();
     Ok((mesh, sum))
+}
+
+/// The inner bodies that are meshed as voids without `regions`: shells
+/// with outward normals whose parent is material (a body floating in a
+/// void stays a body).
+fn bodies_in_material(shells: &[Shell]) -> Vec<usize> {
+    let mut order: Vec<usize> = (0..shells.len()).collect();
+    order.sort_by_key(|&k| shells[k].depth);
+    let mut material = vec![false; shells.len()];
+    let mut out = Vec::new();
+    for k in order {
+        let sh = &shells[k];
+        material[k] = match sh.parent {
+            None => true,
+            Some(p) if material[p as usize] => {
+                if sh.kind == ShellKind::Inner {
+                    out.push(k);
+                }
+                false
+            }
+            Some(_) => sh.kind == ShellKind::Inner,
+        };
+    }
+    out.sort_unstable();
+    out
 }
 
 /// The serial front (§4) on each region, appended to `mesh`.

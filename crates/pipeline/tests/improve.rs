@@ -9,8 +9,10 @@ use parafront_pipeline::{mesh_surface, MeshOptions};
 use parafront_surface::{generate, Surface};
 
 fn front_mesh(s: &Surface) -> TetMesh {
+    // Inner bodies are regions here: their interfaces are constraints too.
     let opts = MeshOptions {
         optimize: 0,
+        regions: true,
         ..MeshOptions::default()
     };
     mesh_surface(s, &opts).unwrap().0

@@ -5,8 +5,22 @@ use parafront_pipeline::{mesh_surface, MeshOptions};
 use parafront_surface::{generate, Surface};
 
 fn mesh(s: &Surface) -> parafront_mesh::TetMesh {
-    let (m, summary) =
-        mesh_surface(s, &MeshOptions::default()).unwrap_or_else(|e| panic!("meshing failed: {e}"));
+    mesh_with(s, &MeshOptions::default())
+}
+
+/// Inner bodies as regions of their own (`--regions`).
+fn mesh_regions(s: &Surface) -> parafront_mesh::TetMesh {
+    mesh_with(
+        s,
+        &MeshOptions {
+            regions: true,
+            ..MeshOptions::default()
+        },
+    )
+}
+
+fn mesh_with(s: &Surface, o: &MeshOptions) -> parafront_mesh::TetMesh {
+    let (m, summary) = mesh_surface(s, o).unwrap_or_else(|e| panic!("meshing failed: {e}"));
     assert_eq!(summary.tets, m.tets.len());
     m.check_against_surface(&s.tris)
         .unwrap_or_else(|e| panic!("invalid mesh: {e}"));
@@ -23,16 +37,45 @@ fn mesh(s: &Surface) -> parafront_mesh::TetMesh {
     m
 }
 
+fn sphere_void_body() -> (Surface, Surface, Surface) {
+    let outer = generate::icosphere([0.0; 3], 2.0, 3);
+    let void = generate::icosphere([0.9, 0.0, 0.0], 0.5, 2).flipped();
+    let body = generate::icosphere([-0.8, 0.2, 0.1], 0.6, 2);
+    (outer, void, body)
+}
+
 #[test]
 fn sphere_with_a_void_and_an_embedded_body() {
-    let mut s = generate::icosphere([0.0; 3], 2.0, 3);
-    s.append(&generate::icosphere([0.9, 0.0, 0.0], 0.5, 2).flipped());
-    s.append(&generate::icosphere([-0.8, 0.2, 0.1], 0.6, 2));
-    let m = mesh(&s);
+    let (mut s, void, body) = sphere_void_body();
+    s.append(&void);
+    s.append(&body);
+    let m = mesh_regions(&s);
     let mut r = m.region.clone();
     r.sort_unstable();
     r.dedup();
     assert_eq!(r.len(), 2, "the outer material and the embedded body");
+    let v = m.volume();
+    assert!((v - s.signed_volume() + body.signed_volume()).abs() < 1e-9 * v);
+}
+
+#[test]
+fn inner_bodies_are_voids_by_default() {
+    // Without `regions` an inner shell bounds a hole whichever way it
+    // faces; the mesh keeps its triangles, turned to face the hole.
+    let (mut s, void, body) = sphere_void_body();
+    s.append(&void);
+    s.append(&body);
+    let (m, sum) = mesh_surface(&s, &MeshOptions::default()).unwrap();
+    assert_eq!(sum.voided_shells.len(), 1);
+    assert_eq!(sum.regions, 1);
+    assert!(m.region.iter().all(|&r| r == m.region[0]));
+    let (mut turned, void, body) = sphere_void_body();
+    turned.append(&void);
+    turned.append(&body.flipped());
+    m.check_against_surface(&turned.tris).unwrap();
+    assert!(m.check_against_surface(&s.tris).is_err());
+    let v = m.volume();
+    assert!((v - turned.signed_volume()).abs() < 1e-9 * v, "{v}");
 }
 
 #[test]
@@ -45,8 +88,8 @@ fn thin_torus() {
 #[test]
 fn demo_part_is_deterministic() {
     let s = generate::demo_part();
-    let a = mesh(&s);
-    let b = mesh(&s);
+    let a = mesh_regions(&s);
+    let b = mesh_regions(&s);
     assert_eq!(a.tets, b.tets);
     assert_eq!(a.points, b.points);
 }

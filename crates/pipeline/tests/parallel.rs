@@ -9,6 +9,7 @@ fn opts(parts: usize, h: f64) -> MeshOptions {
     let mut o = MeshOptions {
         parts,
         optimize: 0,
+        regions: true,
         ..MeshOptions::default()
     };
     o.size.h = Some(h);
