@@ -453,12 +453,15 @@ fn print_summary(sum: &Summary, q: &QualityReport) {
         println!("front: {:.0} tets/s", sum.tets as f64 / front);
     }
     if !sum.voided_shells.is_empty() {
-        let ids: Vec<String> = sum.voided_shells.iter().map(|k| k.to_string()).collect();
+        let n = sum.voided_shells.len();
+        let mut ids: Vec<String> = sum.voided_shells.iter().take(6).map(|k| k.to_string()).collect();
+        if n > 6 {
+            ids.push(format!("and {} more", n - 6));
+        }
+        let s = if n == 1 { "" } else { "s" };
         println!(
-            "inner shell{} {} (outward normals) meshed as void{}; --regions meshes inner bodies as regions",
-            if ids.len() == 1 { "" } else { "s" },
-            ids.join(", "),
-            if ids.len() == 1 { "" } else { "s" }
+            "inner shell{s} {} (outward normals, `parafront check` numbering) meshed as void{s}; --regions meshes inner bodies as regions",
+            ids.join(", ")
         );
     }
     for (r, e) in &sum.serial_fallback {
