@@ -548,6 +548,14 @@ fn run_check(path: &Path) -> Result<(), Fail> {
     let s = read_surface(path)?;
     let report = validate(&s);
     println!("{}: {}", path.display(), report);
+    let bodies = parafront_pipeline::bodies_in_material(&report.shells).len();
+    if bodies > 0 && report.is_valid() {
+        println!(
+            "note: `parafront mesh` meshes the {bodies} inner bod{} as void{} unless given --regions",
+            if bodies == 1 { "y" } else { "ies" },
+            if bodies == 1 { "" } else { "s" }
+        );
+    }
     println!("checked in {:.3} s", t0.elapsed().as_secs_f64());
     if report.is_valid() {
         Ok(())

@@ -251,7 +251,7 @@ pub fn mesh_surface(s: &Surface, opts: &MeshOptions) -> Result<(TetMesh, Summary
 /// The inner bodies that are meshed as voids without `regions`: shells
 /// with outward normals whose parent is material (a body floating in a
 /// void stays a body).
-fn bodies_in_material(shells: &[Shell]) -> Vec<usize> {
+pub fn bodies_in_material(shells: &[Shell]) -> Vec<usize> {
     let mut order: Vec<usize> = (0..shells.len()).collect();
     order.sort_by_key(|&k| shells[k].depth);
     let mut material = vec![false; shells.len()];
