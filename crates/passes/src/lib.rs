@@ -624,8 +624,13 @@ fn front_call(
 
 /// Largest pocket (faces) a pass closes itself.
 const MAX_POCKET: usize = 4000;
-/// Recovery rounds a pocket gets (the serial front's default is 60).
-const POCKET_ROUNDS: u32 = 8;
+/// Recovery rounds a pocket gets (the serial front's default is 60): the
+/// removal round and one of kernel cones. Most pockets that close at all
+/// close there; the late rounds' patch cones cost 30 ms or more per pocket
+/// that stays stuck, and with 8 rounds they took 70 % of pass 2's time
+/// (sphere_1e6 at 0.036, P = 8: pockets 6.8 s, 0.16 s with 2 rounds). What
+/// stays open goes to the next pass.
+const POCKET_ROUNDS: u32 = 2;
 
 /// Recovery inside a pass (§7 needs it as much as the serial front does):
 /// the faces a pass could not advance without relaxing its acceptance are
