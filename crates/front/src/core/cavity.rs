@@ -776,6 +776,12 @@ mod tests {
             .map(|t| f.tets[t])
             .collect();
         assert!(f.fmap.is_empty(), "{} faces left", f.fmap.len());
+        // A face as a cycle starting at its smallest corner: a face and its
+        // turned copy differ.
+        let cycle = |v: [u32; 3]| {
+            let k = (0..3).min_by_key(|&k| v[k]).unwrap_or(0);
+            [v[k], v[(k + 1) % 3], v[(k + 2) % 3]]
+        };
         let mut sum = 0.0;
         let mut faces: FxHashMap<[u32; 3], usize> = FxHashMap::default();
         for tv in &live {
@@ -783,12 +789,18 @@ mod tests {
             assert!(orient3d(a, b, c, d) > 0.0, "tet {tv:?} is not positive");
             sum += tet_volume6(a, b, c, d) / 6.0;
             for fc in TET_FACES {
-                *faces.entry(sorted3(fc.map(|k| tv[k]))).or_default() += 1;
+                *faces.entry(cycle(fc.map(|k| tv[k]))).or_default() += 1;
             }
         }
-        for (k, n) in &faces {
-            let on_input = input.iter().any(|g| sorted3(*g) == *k);
-            assert_eq!(*n, if on_input { 1 } else { 2 }, "face {k:?}");
+        for (&k, &n) in &faces {
+            let turned = cycle([k[0], k[2], k[1]]);
+            let on_input = input.iter().any(|g| sorted3(*g) == sorted3(k));
+            assert_eq!(n, 1, "face {k:?} twice the same way");
+            assert_eq!(
+                faces.contains_key(&turned),
+                !on_input,
+                "face {k:?}: an inner face needs its turned copy, an input face none"
+            );
         }
         assert!((sum - vol).abs() <= 1e-9 * vol, "volume {sum} for {vol}");
         live.len()
@@ -825,7 +837,7 @@ mod tests {
         assert_eq!(pocket.len(), 8);
         let (x, _) = f.deepest_over(&pocket, &f.faces_box(&pocket)).unwrap();
         let worst = f.worst_cone(&pocket, x);
-        assert!(worst < CONE_FLOOR && worst >= INPUT_BOUND_FLOOR, "{worst}");
+        assert!((INPUT_BOUND_FLOOR..CONE_FLOOR).contains(&worst), "{worst}");
         assert!(f.fill_by_kernel(&pocket));
         assert_eq!(assert_fills(&f, &faces, vol), 8);
         assert_eq!(f.pts.len(), 7, "one point inside");
