@@ -30,6 +30,12 @@ const MAX_PATCH_SEEDS: usize = 32;
 const MAX_PATCH: usize = 16;
 /// Worst cone a patch may make before late growth.
 const PATCH_FLOOR: f64 = 0.02;
+/// How far a kernel cone's apex keeps from the front, in mean edges of the
+/// faces it cones. Closer, the new point sits on a front face or beside a
+/// front point, and the slab it leaves (measured on plate_holes: points
+/// 0.002 apart, or 0.002 above an input plane) closes only with tets that
+/// no floor accepts; recovery then wanders without closing.
+const KERNEL_APEX_CLEARANCE: f64 = 0.1;
 
 enum Pocket {
     Filled,
@@ -105,6 +111,9 @@ impl<'a> Front<'a> {
             let pocket = self.pocket(seed);
             if pocket.len() > MAX_POCKET || pocket.iter().any(|&f| self.prohibited_face(f)) {
                 return Pocket::Failed;
+            }
+            if round == 0 && self.relax >= LATE_FROM_ROUND && self.fill_by_kernel(&pocket) {
+                return Pocket::Filled;
             }
             let p = self.kernel_point(&pocket);
             let bad: Vec<u32> = pocket
@@ -195,6 +204,27 @@ impl<'a> Front<'a> {
             }
         }
         Pocket::Failed
+    }
+
+    /// Late recovery (step 5.3): a pocket whose faces all see one point
+    /// is coned from the deepest such point even when the cones are flat
+    /// but float-safe. Growing it first, as early rounds do, removes tets
+    /// that the next rounds must make again: on thin plates the pocket then
+    /// grows round a hole, loses its kernel, and the stuck set wanders.
+    fn fill_by_kernel(&mut self, pocket: &[u32]) -> bool {
+        let bb = self.faces_box(pocket);
+        let Some((x, depth)) = self.deepest_over(pocket, &bb) else {
+            return false;
+        };
+        if depth <= 1e-6 * bb.diagonal()
+            || self.worst_cone(pocket, x) < INPUT_BOUND_FLOOR
+            || !self.region.point_ok(x)
+            || !self.cone_is_free(pocket, x)
+        {
+            return false;
+        }
+        self.commit_cone(pocket, x);
+        true
     }
 
     /// Cone the faces `p` sees well and whose cones are free. Those cones
@@ -318,17 +348,30 @@ impl<'a> Front<'a> {
         bb
     }
 
-    /// Cone the faces of `set` that `x` sees and whose cones are free.
+    /// Mean edge length of `faces`.
+    fn mean_edge(&self, faces: &[u32]) -> f64 {
+        let mut s = 0.0;
+        for &f in faces {
+            let v = self.fv[f as usize].map(|i| self.pts[i as usize]);
+            s += (dist(v[0], v[1]) + dist(v[1], v[2]) + dist(v[2], v[0])) / 3.0;
+        }
+        s / faces.len().max(1) as f64
+    }
+
+    /// Cone the faces of `set` that `x` sees and whose cones are free; `x`
+    /// keeps `KERNEL_APEX_CLEARANCE` from the other front faces and points.
     fn cone_from(&mut self, set: &[u32], x: P3, floor: f64) -> bool {
         if !self.region.point_ok(x) {
             return false;
         }
+        let cl = Clearance {
+            new_point: KERNEL_APEX_CLEARANCE * self.mean_edge(set),
+            ..Clearance::EXACT
+        };
         let take: Vec<u32> = set
             .iter()
             .copied()
-            .filter(|&f| {
-                self.cone_shape(f, x) >= floor && self.apex_free(f, NONE, x, Clearance::EXACT)
-            })
+            .filter(|&f| self.cone_shape(f, x) >= floor && self.apex_free(f, NONE, x, cl))
             .collect();
         if take.is_empty() {
             return false;
@@ -658,9 +701,10 @@ impl<'a> Front<'a> {
         if orient3d(a, b, c, p) <= 0.0 {
             return false;
         }
+        // Wide enough for the apex's own clearance from front faces.
         let bb = tri_box(&self.pts, v)
             .union(&Aabb { min: p, max: p })
-            .inflated(cl.point);
+            .inflated(cl.point.max(cl.new_point));
         let (mut near_f, mut near_p) = (Vec::new(), Vec::new());
         self.gather(&bb, f, &mut near_f, &mut near_p);
         self.tet_is_free(v, q, p, &near_f, &near_p, cl)
@@ -689,5 +733,153 @@ impl<'a> Front<'a> {
             self.commit(f, id, p);
         }
         self.stats.pockets_filled += 1;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::Everywhere;
+
+    /// `faces` turned so their right-hand normals point at `c` (an inner
+    /// point every face sees: the polyhedra here are star-shaped about it).
+    fn inward(p: &[P3], faces: &[[u32; 3]], c: P3) -> Vec<[u32; 3]> {
+        faces
+            .iter()
+            .map(|&[a, b, d]| {
+                if orient3d(p[a as usize], p[b as usize], p[d as usize], c) > 0.0 {
+                    [a, b, d]
+                } else {
+                    [a, d, b]
+                }
+            })
+            .collect()
+    }
+
+    fn volume(p: &[P3], faces: &[[u32; 3]]) -> f64 {
+        // Inward normals: the divergence theorem with the sign turned.
+        -faces
+            .iter()
+            .map(|f| {
+                let [a, b, c] = f.map(|i| p[i as usize]);
+                dot(a, cross(b, c)) / 6.0
+            })
+            .sum::<f64>()
+    }
+
+    /// The tets made are positive, match face to face (the front is
+    /// empty and every tet face is an input face or another tet's, turned)
+    /// and fill the pocket's volume.
+    fn assert_fills(f: &Front, input: &[[u32; 3]], vol: f64) -> usize {
+        let live: Vec<[u32; 4]> = (0..f.tets.len())
+            .filter(|&t| f.talive[t])
+            .map(|t| f.tets[t])
+            .collect();
+        assert!(f.fmap.is_empty(), "{} faces left", f.fmap.len());
+        // A face as a cycle starting at its smallest corner: a face and its
+        // turned copy differ.
+        let cycle = |v: [u32; 3]| {
+            let k = (0..3).min_by_key(|&k| v[k]).unwrap_or(0);
+            [v[k], v[(k + 1) % 3], v[(k + 2) % 3]]
+        };
+        let mut sum = 0.0;
+        let mut faces: FxHashMap<[u32; 3], usize> = FxHashMap::default();
+        for tv in &live {
+            let [a, b, c, d] = tv.map(|i| f.pts[i as usize]);
+            assert!(orient3d(a, b, c, d) > 0.0, "tet {tv:?} is not positive");
+            sum += tet_volume6(a, b, c, d) / 6.0;
+            for fc in TET_FACES {
+                *faces.entry(cycle(fc.map(|k| tv[k]))).or_default() += 1;
+            }
+        }
+        for (&k, &n) in &faces {
+            let turned = cycle([k[0], k[2], k[1]]);
+            let on_input = input.iter().any(|g| sorted3(*g) == sorted3(k));
+            assert_eq!(n, 1, "face {k:?} twice the same way");
+            assert_eq!(
+                faces.contains_key(&turned),
+                !on_input,
+                "face {k:?}: an inner face needs its turned copy, an input face none"
+            );
+        }
+        assert!((sum - vol).abs() <= 1e-9 * vol, "volume {sum} for {vol}");
+        live.len()
+    }
+
+    #[test]
+    fn a_flat_slab_is_coned_from_its_kernel() {
+        // A bipyramid 100 wide and 0.004 thick: every cone from its centre
+        // is below CONE_FLOOR (early rounds would grow the pocket), all far
+        // above rounding.
+        let (w, t) = (50.0, 0.002);
+        let pts: Vec<P3> = vec![
+            [w, w, 0.0],
+            [-w, w, 0.0],
+            [-w, -w, 0.0],
+            [w, -w, 0.0],
+            [0.0, 0.0, t],
+            [0.0, 0.0, -t],
+        ];
+        let raw: Vec<[u32; 3]> = (0..4u32)
+            .flat_map(|i| [[i, (i + 1) % 4, 4], [i, (i + 1) % 4, 5]])
+            .collect();
+        let faces = inward(&pts, &raw, [0.0; 3]);
+        let vol = volume(&pts, &faces);
+        assert!((vol - 4.0 * w * w * 2.0 * t / 3.0).abs() < 1e-9 * vol);
+        let opts = FrontOptions::default();
+        let input = FrontInput {
+            point_size: vec![w; 6],
+            points: pts,
+            faces: faces.clone(),
+        };
+        let mut f = Front::new(input, SizeMode::Growth(1.0), &Everywhere, &opts);
+        let pocket = f.pocket(0);
+        assert_eq!(pocket.len(), 8);
+        let (x, _) = f.deepest_over(&pocket, &f.faces_box(&pocket)).unwrap();
+        let worst = f.worst_cone(&pocket, x);
+        assert!((INPUT_BOUND_FLOOR..CONE_FLOOR).contains(&worst), "{worst}");
+        assert!(f.fill_by_kernel(&pocket));
+        assert_eq!(assert_fills(&f, &faces, vol), 8);
+        assert_eq!(f.pts.len(), 7, "one point inside");
+    }
+
+    #[test]
+    fn a_schoenhardt_prism_needs_and_gets_one_inner_point() {
+        // A triangle and its copy turned by 30 degrees, the side quads cut
+        // on their reflex diagonals: no tet on its own corners fits.
+        let phi = 30f64.to_radians();
+        let mut pts: Vec<P3> = Vec::new();
+        for (z, turn) in [(0.0, 0.0), (1.0, phi)] {
+            for i in 0..3 {
+                let a = 2.0 * std::f64::consts::PI * i as f64 / 3.0 + turn;
+                pts.push([a.cos(), a.sin(), z]);
+            }
+        }
+        let raw = [
+            [0, 1, 2],
+            [3, 5, 4],
+            [0, 4, 1],
+            [0, 3, 4],
+            [1, 5, 2],
+            [1, 4, 5],
+            [2, 3, 0],
+            [2, 5, 3],
+        ];
+        let faces = inward(&pts, &raw, [0.0, 0.0, 0.5]);
+        let vol = volume(&pts, &faces);
+        let opts = FrontOptions::default();
+        let input = FrontInput {
+            point_size: vec![1.0; 6],
+            points: pts,
+            faces: faces.clone(),
+        };
+        let mut f = Front::new(input, SizeMode::Growth(1.0), &Everywhere, &opts);
+        let pocket = f.pocket(0);
+        assert_eq!(pocket.len(), 8);
+        assert!(!f.close_by_existing(&pocket, EXHAUSTIVE_BUDGET));
+        assert_eq!(f.fmap.len(), 8, "the failed search undoes its tets");
+        let pocket = f.pocket(f.first_alive(&pocket, 0).unwrap());
+        assert!(f.fill_by_kernel(&pocket));
+        assert_eq!(assert_fills(&f, &faces, vol), 8);
     }
 }

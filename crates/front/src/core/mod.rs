@@ -22,8 +22,9 @@ const SHAPE_FLOOR: f64 = 2e-3;
 /// 0.7 gives 53k and 2.4 %, 0.5 gets stuck far more often.
 const SEARCH_RADIUS: f64 = 0.7;
 /// Recovery rounds without fewer stuck faces before the front gives up: the
-/// skull needs 14 (its stuck set goes 28, 68, 110, ... 48, 16, 0).
-const STALL_ROUNDS: u32 = 20;
+/// skull needs 14 (its stuck set goes 28, 68, 110, ... 48, 16, 0);
+/// plate_holes 81 (its set wanders between 56 and 330 before it closes).
+const STALL_ROUNDS: u32 = 100;
 /// Marked points a tet needs to leave in a late recovery round.
 const LATE_REMOVAL_POINTS: usize = 2;
 /// A new tet's size is at most this multiple of its face's longest edge.
@@ -65,7 +66,7 @@ impl Default for FrontOptions {
     fn default() -> Self {
         FrontOptions {
             tries_per_face: 3,
-            recovery_rounds: 60,
+            recovery_rounds: 200,
             max_points: u32::MAX as usize - 1,
             progress_every: 4096,
             progress: None,
@@ -437,58 +438,71 @@ pub fn advance(
     if !opts.pass {
         check_closed(&input.faces)?;
     }
-    let n = input.points.len();
-    let bb = Aabb::from_points(&input.points);
-    let hmin = input
-        .point_size
-        .iter()
-        .copied()
-        .filter(|h| *h > 0.0 && h.is_finite())
-        .fold(f64::INFINITY, f64::min);
-    let s0 = if hmin.is_finite() {
-        hmin
-    } else {
-        bb.diagonal().max(1e-300) * 1e-3
-    };
-    let mut f = Front {
-        pts: input.points,
-        hp: input.point_size,
-        n_input: n,
-        fv: Vec::new(),
-        falive: Vec::new(),
-        fowner: Vec::new(),
-        ftries: Vec::new(),
-        fmap: FxHashMap::default(),
-        heap: BinaryHeap::new(),
-        fgrid: LooseGrid::new(s0, bb.min),
-        tets: Vec::new(),
-        neigh: Vec::new(),
-        talive: Vec::new(),
-        stuck: Vec::new(),
-        prohibited: Vec::new(),
-        point_in: Vec::new(),
-        relax: 0,
-        opts,
-        region,
-        size,
-        stats: FrontStats::default(),
-        near_f: Vec::new(),
-        near_p: Vec::new(),
-        cands: Vec::new(),
-        stamp: Vec::new(),
-        epoch: 0,
-    };
-    if let SizeMode::Growth(c) = size {
-        // §5: initial face sizes are multiplied by the growth factor.
-        for h in &mut f.hp {
-            *h *= c;
-        }
-    }
-    for v in input.faces {
-        f.add_face(v, NONE);
-    }
+    let mut f = Front::new(input, size, region, opts);
     f.run()?;
     Ok(f.finish())
+}
+
+impl<'a> Front<'a> {
+    /// The front of `input.faces`, each queued (AF1), no tet made yet.
+    fn new(
+        input: FrontInput,
+        size: SizeMode<'a>,
+        region: &'a dyn RegionFilter,
+        opts: &'a FrontOptions,
+    ) -> Front<'a> {
+        let n = input.points.len();
+        let bb = Aabb::from_points(&input.points);
+        let hmin = input
+            .point_size
+            .iter()
+            .copied()
+            .filter(|h| *h > 0.0 && h.is_finite())
+            .fold(f64::INFINITY, f64::min);
+        let s0 = if hmin.is_finite() {
+            hmin
+        } else {
+            bb.diagonal().max(1e-300) * 1e-3
+        };
+        let mut f = Front {
+            pts: input.points,
+            hp: input.point_size,
+            n_input: n,
+            fv: Vec::new(),
+            falive: Vec::new(),
+            fowner: Vec::new(),
+            ftries: Vec::new(),
+            fmap: FxHashMap::default(),
+            heap: BinaryHeap::new(),
+            fgrid: LooseGrid::new(s0, bb.min),
+            tets: Vec::new(),
+            neigh: Vec::new(),
+            talive: Vec::new(),
+            stuck: Vec::new(),
+            prohibited: Vec::new(),
+            point_in: Vec::new(),
+            relax: 0,
+            opts,
+            region,
+            size,
+            stats: FrontStats::default(),
+            near_f: Vec::new(),
+            near_p: Vec::new(),
+            cands: Vec::new(),
+            stamp: Vec::new(),
+            epoch: 0,
+        };
+        if let SizeMode::Growth(c) = size {
+            // §5: initial face sizes are multiplied by the growth factor.
+            for h in &mut f.hp {
+                *h *= c;
+            }
+        }
+        for v in input.faces {
+            f.add_face(v, NONE);
+        }
+        f
+    }
 }
 
 /// Every directed edge of a closed front appears as often as its reverse.
