@@ -454,7 +454,12 @@ fn print_summary(sum: &Summary, q: &QualityReport) {
     }
     if !sum.voided_shells.is_empty() {
         let n = sum.voided_shells.len();
-        let mut ids: Vec<String> = sum.voided_shells.iter().take(6).map(|k| k.to_string()).collect();
+        let mut ids: Vec<String> = sum
+            .voided_shells
+            .iter()
+            .take(6)
+            .map(|k| k.to_string())
+            .collect();
         if n > 6 {
             ids.push(format!("and {} more", n - 6));
         }

@@ -8,10 +8,10 @@ mod regions;
 pub use parafront_ddg::Partition;
 pub use regions::{material_regions, RegionFront};
 
+use parafront_ddg::DdgError;
 use parafront_front::{advance, FrontError, FrontInput, FrontOptions, SizeMode};
 use parafront_mesh::{CheckError, PointId, QualityReport, TetMesh};
 pub use parafront_passes::process_cpu_seconds;
-use parafront_ddg::DdgError;
 use parafront_passes::{mesh_parallel, ParOptions, ParOutput, ParStats, PassError, Piece};
 use parafront_size::{SizeError, SizeField, SizeOptions, Sizing};
 use parafront_surface::validate::{validate, Report, Shell, ShellKind};
@@ -416,8 +416,12 @@ fn mesh_parts_with(
             // passes leave unclosable (CAD needles next to a part wall) gets
             // the serial front, which recovers from the input surface.
             Err(e @ (PassError::Pass { .. } | PassError::Ddg(DdgError::Front(_)))) => {
-                tracing::warn!(region = rf.region_id, "parallel passes failed ({e}); meshing serially");
-                sum.serial_fallback.push((rf.region_id as usize, e.to_string()));
+                tracing::warn!(
+                    region = rf.region_id,
+                    "parallel passes failed ({e}); meshing serially"
+                );
+                sum.serial_fallback
+                    .push((rf.region_id as usize, e.to_string()));
                 sum.stages
                     .push(("failed passes", t_par.elapsed().as_secs_f64()));
                 let t0 = Instant::now();
