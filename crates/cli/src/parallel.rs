@@ -261,6 +261,11 @@ pub fn run_bench(
                 100.0 * (sum.seconds("ddg") + sum.seconds("partition")) / secs + 0.0,
                 if cpu > 0.0 { 100.0 * ddg_cpu / cpu + 0.0 } else { 0.0 }
             );
+                for (r, e) in &sum.serial_fallback {
+                    println!(
+                        "      ^ region {r}: the passes failed ({e}); the serial front meshed it, and the row's seconds include the failed passes"
+                    );
+                }
             }
         }
     }
