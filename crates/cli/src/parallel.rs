@@ -60,6 +60,13 @@ pub fn print_parallel(sum: &Summary) {
             share(st.pass_tets[3]),
             st.peeled_tets
         );
+        if st.crossing_passes > 0 {
+            println!(
+                "  pass 3 includes {} pass{} on a crossing partition (the front left would have made pass 4 large)",
+                st.crossing_passes,
+                if st.crossing_passes == 1 { "" } else { "es" }
+            );
+        }
         println!(
             "  seconds per pass: {:.3}, {:.3}, {:.3}, {:.3}; critical path (one core per part) {:.3} s",
             st.pass_seconds[0],

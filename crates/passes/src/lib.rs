@@ -112,8 +112,11 @@ pub struct ParStats {
     pub pass_tets: [usize; 4],
     /// Wall seconds of passes 1 to 4 (message building included).
     pub pass_seconds: [f64; 4],
-    /// Per pass 1 to 3, each part's seconds inside the front.
-    pub part_seconds: [Vec<f64>; 3],
+    /// Per parallel pass run (1 to 3, then the crossing passes), each
+    /// part's seconds inside the front.
+    pub part_seconds: Vec<Vec<f64>>,
+    /// Passes on a crossing partition after pass 3 (counted in pass 3).
+    pub crossing_passes: usize,
     pub redistribute_seconds: f64,
 }
 
@@ -384,28 +387,74 @@ pub fn mesh_parallel<C: Comm>(
     let mut next_gid = points.len() as u32;
     let mut made_per_part = vec![0usize; np];
 
-    // §7 step 3, passes 1 to 3.
-    for (j, part_of) in [&part0, &part2, &part3].into_iter().enumerate() {
+    // §7 step 3, passes 1 to 3; then, while the front left would make
+    // pass 4 large, passes on a crossing partition (the other method and
+    // its two shifts): what passes 2 and 3 leave sits where the walls of
+    // both shifts meet, inside the crossing parts (P >= 32 on 1M tets).
+    let mut crossing: Vec<Vec<u32>> = Vec::new();
+    for j in 0..3 + MAX_CROSSING {
         let t0 = Instant::now();
+        if j == 3 {
+            let left = comm.all_reduce(parts.iter().map(|p| p.front.len()).collect(), |a, b| a + b);
+            let made: usize = st.pass_tets.iter().sum();
+            if (left as f64) < CROSSING_FROM * made as f64 {
+                break;
+            }
+            let t = Instant::now();
+            let method = match opts.partition {
+                Partition::Rcb => Partition::Metis,
+                Partition::Metis => Partition::Rcb,
+            };
+            let c = ddg::partition(&d, &w, size, np, method);
+            let c2 = ddg::shifted(&d, &c, Shift::FromHigher, opts.layers);
+            let c3 = ddg::shifted(&d, &c, Shift::FromLower, opts.layers);
+            crossing = vec![c, c2, c3];
+            st.partition_seconds += t.elapsed().as_secs_f64();
+        } else if j > 3 {
+            let left = comm.all_reduce(parts.iter().map(|p| p.front.len()).collect(), |a, b| a + b);
+            let made: usize = st.pass_tets.iter().sum();
+            if (left as f64) < CROSSING_FROM * made as f64 {
+                break;
+            }
+        }
+        let part_of: &[u32] = match j {
+            0 => &part0,
+            1 => &part2,
+            2 => &part3,
+            _ => &crossing[j - 3],
+        };
+        // The crossing passes count as pass 3.
+        let label = j.min(2);
         let regions = DdgRegions {
             d: &d,
             loc: &loc,
             walls: Interfaces::new(&d, part_of),
             part_of,
         };
-        let (tets, secs) =
-            parallel_pass(&mut parts, comm, &regions, size, j as u8 + 1, &mut next_gid)?;
+        let (tets, secs) = parallel_pass(
+            &mut parts,
+            comm,
+            &regions,
+            size,
+            label as u8 + 1,
+            &mut next_gid,
+        )?;
         for (k, &n) in tets.iter().enumerate() {
             made_per_part[k] += n;
         }
-        st.pass_tets[j] = tets.iter().sum();
-        st.part_seconds[j] = secs;
+        st.pass_tets[label] += tets.iter().sum::<usize>();
+        st.part_seconds.push(secs);
+        st.crossing_passes = j.saturating_sub(2);
         if std::env::var_os("PARAFRONT_DEBUG_PASSES").is_some() {
             let fr: usize = parts.iter().map(|p| p.front.len()).sum();
             let stuck: usize = parts.iter().map(|p| p.stuck.len() / 3).sum();
             eprintln!(
                 "pass {} tets {:?} front left {fr}, {stuck} stuck",
-                j + 1,
+                if j < 3 {
+                    format!("{}", j + 1)
+                } else {
+                    format!("3 (crossing {})", j - 2)
+                },
                 tets
             );
         }
@@ -418,7 +467,7 @@ pub fn mesh_parallel<C: Comm>(
             );
         }
         st.peeled_tets += peeled;
-        st.pass_seconds[j] = t0.elapsed().as_secs_f64();
+        st.pass_seconds[label] += t0.elapsed().as_secs_f64();
     }
     let mean = made_per_part.iter().sum::<usize>() as f64 / np as f64;
     st.made_imbalance = if mean > 0.0 {
@@ -621,6 +670,13 @@ fn front_call(
         seconds: t0.elapsed().as_secs_f64(),
     })
 }
+
+/// Crossing passes after pass 3: one on a partition by the other method,
+/// then one on each of its shifts.
+const MAX_CROSSING: usize = 3;
+/// A crossing pass runs while the front left has more faces than this
+/// share of the tets made (pass 4 makes about a tet per face left).
+const CROSSING_FROM: f64 = 0.0025;
 
 /// Largest pocket (faces) a pass closes itself.
 const MAX_POCKET: usize = 4000;
