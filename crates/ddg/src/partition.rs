@@ -173,6 +173,14 @@ const UFACTOR: i32 = 10;
 /// the same input gives the same partition whatever else runs.
 static METIS: Mutex<()> = Mutex::new(());
 
+/// METIS's integer weights: `xs` scaled, rounded, and kept within
+/// 1..=2^28 (every vertex and edge counts; 32-bit sums keep room).
+fn metis_weights(xs: &[f64], scale: f64) -> Vec<i32> {
+    xs.iter()
+        .map(|&x| ((x * scale).round() as i64).clamp(1, 1 << 28) as i32)
+        .collect()
+}
+
 /// METIS k-way partition of the dual graph (§6 with a graph refinement:
 /// METIS coarsens, splits and refines with FM, lowering the cut). Vertex
 /// weights are `w` scaled to integers, edge weights the fine faces across
@@ -193,10 +201,7 @@ pub fn metis_kway(d: &Ddg, w: &[f64], h: &(dyn Fn(P3) -> f64 + Sync), parts: usi
     } else {
         1.0
     };
-    let vwgt: Vec<i32> = w
-        .iter()
-        .map(|&x| ((x * scale).round() as i64).clamp(1, 1 << 28) as i32)
-        .collect();
+    let vwgt = metis_weights(w, scale);
     // Each face's weight once (from its lower tet), in parallel: the
     // size field is the costly part of building the graph.
     let fw: Vec<[f64; 4]> = (0..n)
@@ -228,10 +233,7 @@ pub fn metis_kway(d: &Ddg, w: &[f64], h: &(dyn Fn(P3) -> f64 + Sync), parts: usi
     } else {
         1.0
     };
-    let adjwgt: Vec<i32> = ew
-        .iter()
-        .map(|&x| ((x * escale).round() as i64).clamp(1, 1 << 28) as i32)
-        .collect();
+    let adjwgt = metis_weights(&ew, escale);
     let contig = components(d, &vec![0u32; n], 1)[0] == 1;
     let mut part = vec![0i32; n];
     let res = {

@@ -394,12 +394,14 @@ pub fn mesh_parallel<C: Comm>(
     let mut crossing: Vec<Vec<u32>> = Vec::new();
     for j in 0..3 + MAX_CROSSING {
         let t0 = Instant::now();
-        if j == 3 {
+        if j >= 3 {
             let left = comm.all_reduce(parts.iter().map(|p| p.front.len()).collect(), |a, b| a + b);
             let made: usize = st.pass_tets.iter().sum();
             if (left as f64) < CROSSING_FROM * made as f64 {
                 break;
             }
+        }
+        if j == 3 {
             let t = Instant::now();
             let method = match opts.partition {
                 Partition::Rcb => Partition::Metis,
@@ -410,12 +412,6 @@ pub fn mesh_parallel<C: Comm>(
             let c3 = ddg::shifted(&d, &c, Shift::FromLower, opts.layers);
             crossing = vec![c, c2, c3];
             st.partition_seconds += t.elapsed().as_secs_f64();
-        } else if j > 3 {
-            let left = comm.all_reduce(parts.iter().map(|p| p.front.len()).collect(), |a, b| a + b);
-            let made: usize = st.pass_tets.iter().sum();
-            if (left as f64) < CROSSING_FROM * made as f64 {
-                break;
-            }
         }
         let part_of: &[u32] = match j {
             0 => &part0,

@@ -14,7 +14,7 @@ use parafront_mesh::{CheckError, PointId, QualityReport, TetMesh};
 pub use parafront_passes::process_cpu_seconds;
 use parafront_passes::{mesh_parallel, ParOptions, ParOutput, ParStats, PassError, Piece};
 use parafront_size::{SizeError, SizeField, SizeOptions, Sizing};
-use parafront_surface::validate::{validate, Report, Shell, ShellKind};
+use parafront_surface::validate::{shells, validate, Report, Shell, ShellKind};
 use parafront_surface::Surface;
 use serde::{Deserialize, Serialize};
 use std::time::Instant;
@@ -177,9 +177,12 @@ pub fn mesh_surface(s: &Surface, opts: &MeshOptions) -> Result<(TetMesh, Summary
                 t.tris[f as usize].swap(1, 2);
             }
         }
-        report = validate(&t);
-        if !report.is_valid() {
-            return Err(MeshError::InvalidSurface(Box::new(report)));
+        // Turning a shell changes only the shells' signs and kinds: the
+        // rest of the validation stands, and runs again only to report a
+        // shell that now has the wrong sign (a void inside a turned body).
+        report.shells = shells(&t);
+        if report.shells.iter().any(|sh| !sh.orientation_ok()) {
+            return Err(MeshError::InvalidSurface(Box::new(validate(&t))));
         }
         turned = t;
         &turned
@@ -193,14 +196,17 @@ pub fn mesh_surface(s: &Surface, opts: &MeshOptions) -> Result<(TetMesh, Summary
     sum.stages.push(("size field", t0.elapsed().as_secs_f64()));
 
     let t0 = Instant::now();
-    let mut mesh = TetMesh {
-        points: s.points.clone(),
-        bnd_tris: s.tris.iter().map(|t| t.map(PointId)).collect(),
-        bnd_patch: s.patch.clone(),
-        ..Default::default()
-    };
+    let mut mesh = surface_mesh(s);
     if opts.parts > 1 {
-        mesh_parts(s, &fronts, &sizing, opts, &mut mesh, &mut sum)?;
+        mesh_parts(
+            s,
+            &fronts,
+            &sizing,
+            opts,
+            &mut mesh,
+            &mut sum,
+            mesh_parallel,
+        )?;
     } else {
         mesh_serial(s, &fronts, &sizing, opts, &mut mesh, &mut sum)?;
         sum.stages.push(("front", t0.elapsed().as_secs_f64()));
@@ -271,6 +277,16 @@ pub fn bodies_in_material(shells: &[Shell]) -> Vec<usize> {
     }
     out.sort_unstable();
     out
+}
+
+/// A mesh of `s`'s points and boundary triangles, no tets yet.
+fn surface_mesh(s: &Surface) -> TetMesh {
+    TetMesh {
+        points: s.points.clone(),
+        bnd_tris: s.tris.iter().map(|t| t.map(PointId)).collect(),
+        bnd_patch: s.patch.clone(),
+        ..Default::default()
+    }
 }
 
 /// The serial front (§4) on each region, appended to `mesh`.
@@ -368,21 +384,10 @@ fn append_region(
     base
 }
 
-/// The parallel mesher (§5 to §8) on each region, on the threads backend;
-/// the merged result goes into `mesh` like the serial front's.
+/// The parallel mesher (§5 to §8, `parallel`: `mesh_parallel`, or one
+/// that fails in tests) on each region, on the threads backend; the
+/// merged result goes into `mesh` like the serial front's.
 fn mesh_parts(
-    s: &Surface,
-    fronts: &[RegionFront],
-    sizing: &Sizing,
-    opts: &MeshOptions,
-    mesh: &mut TetMesh,
-    sum: &mut Summary,
-) -> Result<(), MeshError> {
-    mesh_parts_with(s, fronts, sizing, opts, mesh, sum, mesh_parallel)
-}
-
-/// [`mesh_parts`] with the parallel mesher given (tests make it fail).
-fn mesh_parts_with(
     s: &Surface,
     fronts: &[RegionFront],
     sizing: &Sizing,
@@ -534,14 +539,9 @@ mod tests {
             ..MeshOptions::default()
         };
         let sizing = Sizing::build(&s, &opts.size, None).unwrap();
-        let mut mesh = TetMesh {
-            points: s.points.clone(),
-            bnd_tris: s.tris.iter().map(|t| t.map(PointId)).collect(),
-            bnd_patch: s.patch.clone(),
-            ..Default::default()
-        };
+        let mut mesh = surface_mesh(&s);
         let mut sum = Summary::default();
-        mesh_parts_with(&s, &fronts, &sizing, &opts, &mut mesh, &mut sum, stuck).unwrap();
+        mesh_parts(&s, &fronts, &sizing, &opts, &mut mesh, &mut sum, stuck).unwrap();
         assert_eq!(sum.serial_fallback.len(), 1);
         assert_eq!(sum.serial_fallback[0].0, 1);
         assert!(sum.serial_fallback[0].1.contains("pass 4"));
