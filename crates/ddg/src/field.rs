@@ -56,6 +56,11 @@ impl GradedField {
     /// surface point).
     pub fn of_front(points: &[P3], faces: &[[u32; 3]], slope: f64) -> GradedField {
         let h = parafront_surface::mean_edge_lengths(points, faces);
+        GradedField::of_sizes(points, &h, slope)
+    }
+
+    /// Seeded by the points with a positive size `h[i]`.
+    pub fn of_sizes(points: &[P3], h: &[f64], slope: f64) -> GradedField {
         let seeds = (0..points.len())
             .filter(|&i| h[i] > 0.0)
             .map(|i| (points[i], h[i]))

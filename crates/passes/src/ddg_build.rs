@@ -249,11 +249,7 @@ pub fn build_ddg<C: Comm>(
     // times the growth), not from the fine ones: from the fine ones, the
     // layer over the first one gets it the first one's size again, and the
     // DDG of sphere_5e6 has 429k tets instead of 362k.
-    let seeds = (0..points.len())
-        .filter(|&i| point_size[i] > 0.0)
-        .map(|i| (points[i], point_size[i]))
-        .collect();
-    let field = ddg::GradedField::new(seeds, (c - 1.0).max(0.0));
+    let field = ddg::GradedField::of_sizes(points, &point_size, (c - 1.0).max(0.0));
     let field = move |p: P3| field.size(p);
     st.field_seconds = t0.elapsed().as_secs_f64();
     let domain = Aabb::from_points(points.iter());

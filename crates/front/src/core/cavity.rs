@@ -234,14 +234,7 @@ impl<'a> Front<'a> {
             return Pocket::Failed;
         }
         // A new point on top of an old one would make slivers later.
-        let hmean = pocket
-            .iter()
-            .map(|&f| {
-                let v = self.fv[f as usize].map(|i| self.pts[i as usize]);
-                (dist(v[0], v[1]) + dist(v[1], v[2]) + dist(v[2], v[0])) / 3.0
-            })
-            .sum::<f64>()
-            / pocket.len() as f64;
+        let hmean = self.mean_edge(pocket);
         let (mut nf, mut np) = (Vec::new(), Vec::new());
         self.gather(
             &Aabb { min: p, max: p }.inflated(0.2 * hmean),
