@@ -470,7 +470,7 @@ fn print_summary(sum: &Summary, q: &QualityReport) {
         );
     }
     for (r, e) in &sum.serial_fallback {
-        println!("region {r}: the parallel passes failed ({e}); meshed by the serial front");
+        println!("region {r}: meshed by the serial front, the parallel passes gave way: {e}");
     }
     if sum.recovery_rounds > 0 {
         println!(

@@ -20,7 +20,7 @@ use parafront_ddg::{self as ddg, Ddg, Interfaces, Locator, PartFilter, Shift};
 use parafront_front::{
     advance, Everywhere, FrontError, FrontInput, FrontOptions, RegionFilter, SizeMode,
 };
-use parafront_geom::{Aabb, P3};
+use parafront_geom::{tet_volume6, Aabb, P3};
 use rayon::prelude::*;
 use rustc_hash::FxHashMap;
 use std::time::Instant;
@@ -69,6 +69,13 @@ pub enum PassError {
     },
     #[error("redistribution: {0}")]
     Redistribute(String),
+    /// Passes 1 to 3 left most of the region to the serial pass 4: a thin
+    /// part, whose DDG has little interior to split.
+    #[error(
+        "passes 1 to 3 left {:.0} % of the volume to the serial pass 4 (a thin part: the walls between parts cross most of it)",
+        100.0 * left
+    )]
+    Unsuited { left: f64 },
 }
 
 /// What the passes did, for the summary and the benchmark table.
@@ -472,6 +479,16 @@ pub fn mesh_parallel<C: Comm>(
         1.0
     };
 
+    // A thin part leaves most of its volume to pass 4: then the serial
+    // front on the whole region is both faster and the serial mesh.
+    let left = left_fraction(&parts, comm, points, faces);
+    if std::env::var_os("PARAFRONT_DEBUG_PASSES").is_some() {
+        eprintln!("before pass 4: {:.2} % of the volume left", 100.0 * left);
+    }
+    if left > serial_from() {
+        return Err(PassError::Unsuited { left });
+    }
+
     // Pass 4: what is left, serially on part 0.
     let t0 = Instant::now();
     let (made4, removed) = serial_pass(&mut parts, comm, size, &mut next_gid)?;
@@ -673,6 +690,45 @@ const MAX_CROSSING: usize = 3;
 /// A crossing pass runs while the front left has more faces than this
 /// share of the tets made (pass 4 makes about a tet per face left).
 const CROSSING_FROM: f64 = 0.0025;
+
+/// Share of the region's volume left after pass 3 above which the region
+/// is meshed serially instead ([`PassError::Unsuited`]); the environment
+/// variable `PARAFRONT_SERIAL_FROM` overrides it (2: never).
+const SERIAL_FROM: f64 = 0.25;
+
+/// The share of the volume inside `faces` (the input front) that the
+/// parts' fronts still enclose.
+fn left_fraction<C: Comm>(parts: &[Part], comm: &C, points: &[P3], faces: &[[u32; 3]]) -> f64 {
+    let Some(f0) = faces.first() else {
+        return 0.0;
+    };
+    let o = points[f0[0] as usize];
+    let vol6 = |pts: &[P3], fs: &[[u32; 3]]| -> f64 {
+        fs.iter()
+            .map(|f| {
+                let [a, b, c] = f.map(|i| pts[i as usize]);
+                tet_volume6(o, a, b, c)
+            })
+            .sum()
+    };
+    let left = comm.all_reduce(
+        parts.iter().map(|p| vol6(&p.pts, &p.front)).collect(),
+        |a, b| a + b,
+    );
+    let all = vol6(points, faces);
+    if all != 0.0 {
+        left / all
+    } else {
+        0.0
+    }
+}
+
+fn serial_from() -> f64 {
+    std::env::var("PARAFRONT_SERIAL_FROM")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(SERIAL_FROM)
+}
 
 /// Largest pocket (faces) a pass closes itself.
 const MAX_POCKET: usize = 4000;

@@ -124,7 +124,8 @@ pub struct Summary {
     /// bodies and meshed as voids, without `regions`.
     pub voided_shells: Vec<usize>,
     /// Regions (ids as in the mesh) the parallel passes could not close,
-    /// meshed by the serial front instead, with the passes' error.
+    /// or left mostly to pass 4, meshed by the serial front instead, with
+    /// the reason.
     pub serial_fallback: Vec<(usize, String)>,
     /// Quality of the front's mesh before improvement (when it ran).
     pub quality_before: Option<QualityReport>,
@@ -419,16 +420,21 @@ fn mesh_parts(
             Ok(out) => out,
             // A valid surface must not fail (AF5, step 4): a front the
             // passes leave unclosable (CAD needles next to a part wall) gets
-            // the serial front, which recovers from the input surface.
-            Err(e @ (PassError::Pass { .. } | PassError::Ddg(DdgError::Front(_)))) => {
+            // the serial front, which recovers from the input surface. So
+            // does a thin part whose passes leave most of it to pass 4.
+            Err(
+                e @ (PassError::Pass { .. }
+                | PassError::Unsuited { .. }
+                | PassError::Ddg(DdgError::Front(_))),
+            ) => {
                 tracing::warn!(
                     region = rf.region_id,
-                    "parallel passes failed ({e}); meshing serially"
+                    "parallel passes given up ({e}); meshing serially"
                 );
                 sum.serial_fallback
                     .push((rf.region_id as usize, e.to_string()));
                 sum.stages
-                    .push(("failed passes", t_par.elapsed().as_secs_f64()));
+                    .push(("passes given up", t_par.elapsed().as_secs_f64()));
                 let t0 = Instant::now();
                 serial_region(s, rf, sizing, opts, mesh, sum)?;
                 sum.stages.push(("front", t0.elapsed().as_secs_f64()));

@@ -120,3 +120,32 @@ fn needle_plates_mesh() {
         );
     }
 }
+
+/// A thin plate leaves most of its volume to pass 4 (every wall between
+/// parts crosses it): it is meshed by the serial front, so the mesh is the
+/// serial one, and the summary says why. A thick body keeps its passes.
+#[test]
+fn thin_plates_skip_the_passes() {
+    let s = generate::needle_plate(1.0, 64);
+    let par = MeshOptions {
+        parts: 8,
+        ..MeshOptions::default()
+    };
+    let (serial, _) = mesh_surface(&s, &MeshOptions::default()).unwrap();
+    let (m, summary) = mesh_surface(&s, &par).unwrap();
+    m.check_against_surface(&s.tris).unwrap();
+    assert_eq!(summary.serial_fallback.len(), 1, "{summary:?}");
+    assert!(
+        summary.serial_fallback[0].1.contains("of the volume"),
+        "{}",
+        summary.serial_fallback[0].1
+    );
+    assert_eq!(m.tets, serial.tets);
+    assert_eq!(m.points, serial.points);
+
+    let ball = generate::icosphere([0.0; 3], 1.0, 3);
+    let (m, summary) = mesh_surface(&ball, &par).unwrap();
+    m.check_against_surface(&ball.tris).unwrap();
+    assert!(summary.serial_fallback.is_empty());
+    assert_eq!(summary.parallel.len(), 1);
+}
