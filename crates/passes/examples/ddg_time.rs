@@ -64,6 +64,17 @@ fn main() {
                                 t2 - t1, t3 - t2, t4 - t3, t5 - t4, d.points.len(), t6 - t5
                             );
                         }
+                        if std::env::var_os("DDG_COUNT").is_some() {
+                            let mut by = [0usize; 5];
+                            for t in &d.tets {
+                                by[t.iter().filter(|&&i| (i as usize) < d.n_input).count()] += 1;
+                            }
+                            println!(
+                                "tets by surface points 0..4: {by:?}; {} new points, {} surface points",
+                                d.points.len() - d.n_input,
+                                d.n_input
+                            );
+                        }
                         if std::env::var_os("DDG_FIELD_TIME").is_some() {
                             let f = parafront_ddg::graded_field(&s.points, &faces, c).unwrap();
                             let t0 = Instant::now();

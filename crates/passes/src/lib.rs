@@ -491,7 +491,7 @@ pub fn mesh_parallel<C: Comm>(
 
     // Pass 4: what is left, serially on part 0.
     let t0 = Instant::now();
-    let (made4, removed) = serial_pass(&mut parts, comm, size, &mut next_gid)?;
+    let (made4, removed) = serial_pass(&mut parts, comm, size, &mut next_gid, &PASS4_ROUNDS)?;
     st.pass_tets[3] = made4;
     st.peeled_tets += removed;
     st.pass_seconds[3] = t0.elapsed().as_secs_f64();
@@ -1104,8 +1104,9 @@ fn cancel_pairs(hole: &mut Vec<[Rec; 3]>) {
     });
 }
 
-/// Layers peeled around the front before pass 4 gives up.
-const MAX_PEEL: usize = 4;
+/// Recovery rounds of pass 4's tries; a layer is peeled before each try
+/// after the first.
+const PASS4_ROUNDS: [u32; 5] = [1, 12, 12, 12, 60];
 
 /// Pass 4: every part sends what is left of its front to part 0, which
 /// closes it with the serial front (recovery on). What passes 1 to 3 left
@@ -1113,13 +1114,16 @@ const MAX_PEEL: usize = 4;
 /// can only remove tets of its own call: so the parts first remove the
 /// tets touching the left-over front (one layer, one more per try when the
 /// serial front still gets stuck) and send their faces along.
-/// Returns the tets made and the tets removed.
-fn serial_pass<C: Comm>(
+/// `rounds`: the recovery rounds of each try. Returns the tets made and
+/// the tets removed.
+pub(crate) fn serial_pass<C: Comm>(
     parts: &mut [Part],
     comm: &C,
     size: &(dyn Fn(P3) -> f64 + Sync),
     next_gid: &mut u32,
+    rounds: &[u32],
 ) -> Result<(usize, usize), PassError> {
+    let last = rounds.len() - 1;
     let out: Vec<Vec<(u32, [Rec; 3])>> = parts
         .iter_mut()
         .map(|p| {
@@ -1166,12 +1170,8 @@ fn serial_pass<C: Comm>(
                 // Bounded: peeling a layer is the better next step. The first
                 // try removes only its own tets once: recovery's pocket
                 // filling (round 2 on) trips on some left-over fronts.
-                recovery_rounds: match peel {
-                    0 => 1,
-                    p if p < MAX_PEEL => 12,
-                    _ => 60,
-                },
-                keep_partial: peel < MAX_PEEL,
+                recovery_rounds: rounds[peel],
+                keep_partial: peel < last,
                 ..FrontOptions::default()
             },
         );
@@ -1184,7 +1184,7 @@ fn serial_pass<C: Comm>(
         }
         let res = match res {
             Ok(r) => r,
-            Err(FrontError::Stuck { partial, .. }) if peel < MAX_PEEL => {
+            Err(FrontError::Stuck { partial, .. }) if peel < last => {
                 // The older points of the faces left: recovery could not
                 // remove the tets of the passes around them.
                 let mut g: Vec<u32> = partial

@@ -471,6 +471,9 @@ fn mesh_parts(
         }
         sum.parallel.push(out.stats);
     }
+    if sum.parallel.is_empty() {
+        return Ok(()); // every region went to the serial front
+    }
     for (name, x) in [
         "ddg",
         "partition",
