@@ -328,3 +328,140 @@ impl Work<'_> {
         PointId::new(self.m.points.len() - 1)
     }
 }
+
+/// Cost of a new tet for the count swaps: 1000 if under [`BAD_DEG`],
+/// plus its shortfall below 12°; `None` when not positive. Also its min
+/// dihedral.
+fn cost(x: [P3; 4]) -> Option<(f64, f64)> {
+    if !positive(x) {
+        return None;
+    }
+    let d = min_dihedral_deg(x);
+    let bad = if d < BAD_DEG { 1000.0 } else { 0.0 };
+    Some((bad + (12.0 - d).max(0.0), d))
+}
+
+impl Work<'_> {
+    /// Swaps for the dihedral count (§9.1's 2-3 and edge removal, judged
+    /// as the insertion is): the best of the 4 face swaps and 6 edge
+    /// removals of tet `t` that leaves fewer tets under [`BAD_DEG`] and a
+    /// min dihedral no lower. Edge removal takes the triangulation of the
+    /// ring with the least summed cost (Klincsek's programme on a sum).
+    pub(crate) fn eval_count_swap(
+        &self,
+        t: u32,
+        s: &mut InsScratch,
+        c: &mut Cand,
+    ) -> crate::Outcome {
+        use crate::Outcome;
+        let v = self.m.tets[t as usize];
+        // (cost change, under, dmin) of the best candidate so far.
+        let mut best: Option<(f64, usize, f64)> = None;
+        let mut found = Outcome::NotBetter;
+        for f in 0..4 {
+            let Some(n) = self.free_neighbour(t, f) else {
+                continue;
+            };
+            let nt = n.tet().0;
+            let e = self.m.tets[nt as usize][n.local()];
+            let d = v[f];
+            let [a, b, cc] = TET_FACES[f].map(|l| v[l]);
+            let new = [[d, e, a, b], [d, e, b, cc], [d, e, cc, a]];
+            s.cav.clear();
+            s.cav.extend([t, nt]);
+            let old = self.score_old(&s.cav);
+            let mut sum = 0.0;
+            let mut under = 0;
+            let mut dmin = f64::INFINITY;
+            let mut ok = true;
+            for nv in new {
+                match cost(self.pts(nv)) {
+                    Some((k, dd)) => {
+                        sum += k;
+                        under += usize::from(dd < BAD_DEG);
+                        dmin = dmin.min(dd);
+                    }
+                    None => ok = false,
+                }
+            }
+            let gain = sum - (1000.0 * old.under as f64 + old.short);
+            if ok && under < old.under && dmin >= old.dmin && best.is_none_or(|b| gain < b.0) {
+                best = Some((gain, under, dmin));
+                c.old.clear();
+                c.old.extend([t, nt]);
+                c.new.clear();
+                c.new.extend(new);
+                found = Outcome::Done;
+            }
+        }
+        for e in TET_EDGES {
+            let (a, b) = (v[e[0]], v[e[1]]);
+            if self.ring(t, a, b, &mut s.tets, &mut s.ring).is_none() {
+                continue;
+            }
+            s.cav.clear();
+            s.cav.extend_from_slice(&s.tets);
+            let old = self.score_old(&s.cav);
+            let n = s.ring.len();
+            let (pa, pb) = (self.m.points[a.idx()], self.m.points[b.idx()]);
+            let r: Vec<P3> = s.ring.iter().map(|p| self.m.points[p.idx()]).collect();
+            // dp[i][j]: (cost, k, under, dmin) of the best triangulation of
+            // the ring polygon i..j.
+            const N: usize = crate::work::MAX_RING;
+            let mut dp = [[(0.0f64, 0usize, 0usize, f64::INFINITY); N]; N];
+            for len in 2..n {
+                for i in 0..n - len {
+                    let j = i + len;
+                    let mut bk = (f64::INFINITY, 0, 0, 0.0);
+                    for k in i + 1..j {
+                        let (l, rr) = (dp[i][k], dp[k][j]);
+                        if l.0 + rr.0 >= bk.0 {
+                            continue;
+                        }
+                        let (Some(t1), Some(t2)) =
+                            (cost([r[i], r[k], r[j], pb]), cost([r[i], r[j], r[k], pa]))
+                        else {
+                            continue;
+                        };
+                        let sum = l.0 + rr.0 + t1.0 + t2.0;
+                        if sum < bk.0 {
+                            let under = l.2
+                                + rr.2
+                                + usize::from(t1.1 < BAD_DEG)
+                                + usize::from(t2.1 < BAD_DEG);
+                            bk = (sum, k, under, l.3.min(rr.3).min(t1.1).min(t2.1));
+                        }
+                    }
+                    dp[i][j] = bk;
+                }
+            }
+            let (sum, _, under, dmin) = dp[0][n - 1];
+            let gain = sum - (1000.0 * old.under as f64 + old.short);
+            if !sum.is_finite()
+                || under >= old.under
+                || dmin < old.dmin
+                || best.is_some_and(|b| gain >= b.0)
+            {
+                continue;
+            }
+            best = Some((gain, under, dmin));
+            c.new.clear();
+            let mut stack = vec![(0usize, n - 1)];
+            while let Some((i, j)) = stack.pop() {
+                if j - i < 2 {
+                    continue;
+                }
+                let k = dp[i][j].1;
+                let (ri, rk, rj) = (s.ring[i], s.ring[k], s.ring[j]);
+                c.new.push([ri, rk, rj, b]);
+                c.new.push([ri, rj, rk, a]);
+                stack.push((i, k));
+                stack.push((k, j));
+            }
+            c.old.clear();
+            c.old.extend_from_slice(&s.tets);
+            found = Outcome::Done;
+        }
+        found
+    }
+}

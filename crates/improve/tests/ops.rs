@@ -339,3 +339,30 @@ fn insertion_refused_when_nothing_gets_better() {
     assert_eq!(m.tets, before.tets);
     assert_eq!(m.points, before.points);
 }
+
+#[test]
+fn swap_for_the_dihedral_angles() {
+    // Two flat tets on a wide triangle, both under 10°: the 2-3 swap
+    // leaves none under 10°.
+    let s = 3f64.sqrt() / 2.0;
+    let pts = vec![
+        [1.0, 0.0, 0.0],
+        [-0.5, s, 0.0],
+        [-0.5, -s, 0.0],
+        [0.0, 0.0, -0.06],
+        [0.0, 0.0, 0.06],
+    ];
+    let mut m = mesh(pts, &[[0, 1, 2, 4], [0, 2, 1, 3]]);
+    let (tr, vol, d0) = (tris(&m), m.volume(), min_dihedral(&m));
+    assert_eq!(under_10(&m), 2);
+    let mut imp = Improver::new(&mut m, &[]).unwrap();
+    assert_eq!(imp.swap_for_dihedral(0), Outcome::Done);
+    // Now nothing under 10° is left around tet 0.
+    assert_eq!(imp.swap_for_dihedral(0), Outcome::NotBetter);
+    imp.finish();
+    m.check().unwrap();
+    assert_eq!(m.tets.len(), 3);
+    assert_same_domain(&m, &tr, vol);
+    assert_eq!(under_10(&m), 0);
+    assert!(min_dihedral(&m) > d0);
+}
