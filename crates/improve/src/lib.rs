@@ -15,9 +15,8 @@
 //!   ball's min dihedral, within a tenth of the ball's worst mean ratio.
 //! - For the tets under 10° (issue 5), after all that: their free points
 //!   move and swaps are done to leave fewer of them, and new points go in
-//!   (Steiner points, not in the paper: `insert.rs`), only in serial runs
-//!   and in the final polish of a parallel one, so that parts keep their
-//!   point ids.
+//!   (Steiner points, not in the paper: `insert.rs`); in serial runs and
+//!   in the final polish of a parallel one (parts keep their point ids).
 //!
 //! One quality measure drives every operation but the last four: the
 //! mean ratio ([`quality::quality`]); those work on the dihedral angles,
@@ -153,7 +152,7 @@ pub fn improve(
         imp.selective_pass(POLISH, &mut st);
         imp.swap_pass(POLISH, &mut st);
         imp.dihedral_pass(&mut st);
-        imp.dihedral_count_passes(true, &mut st);
+        imp.dihedral_count_passes(&mut st);
         imp.dihedral_pass(&mut st);
         st.points_removed += imp.w.compact(true).iter().filter(|&&d| d).count();
     }
@@ -188,14 +187,15 @@ const POLISH: f64 = 0.5;
 
 /// The serial schedule of one level over a whole mesh (or one part);
 /// returns which points died. With `drop_points` false the dead points
-/// stay in the array (unused) so that ids do not shift.
+/// stay in the array (unused) so that ids do not shift. `whole`: the
+/// whole mesh, not a part; only then the passes for the tets under 10°.
 pub(crate) fn run(
     mesh: &mut TetMesh,
     frozen: &[bool],
     level: u8,
     st: &mut ImproveStats,
     drop_points: bool,
-    insert: bool,
+    whole: bool,
 ) -> Result<Vec<bool>, TopoError> {
     let mut imp = Improver::new(mesh, frozen)?;
     let lv = level.min(3);
@@ -224,10 +224,14 @@ pub(crate) fn run(
     }
     if lv >= 2 {
         imp.swap_pass(FINAL_SWAP, st);
-        // Lift the worst first: what follows never lowers the min dihedral.
         imp.dihedral_pass(st);
-        imp.dihedral_count_passes(insert, st);
-        imp.dihedral_pass(st);
+        // On the whole mesh only (parts leave it to the final polish):
+        // what follows never lowers the min dihedral, so the result keeps
+        // at least the min of the passes before.
+        if whole {
+            imp.dihedral_count_passes(st);
+            imp.dihedral_pass(st);
+        }
     }
     Ok(imp.w.compact(drop_points))
 }
@@ -379,26 +383,14 @@ impl<'m> Improver<'m> {
         let mut round = 0;
         while round < INSERT_ROUNDS + LIFT_ROUNDS + 1 {
             let lift = (INSERT_ROUNDS..INSERT_ROUNDS + LIFT_ROUNDS).contains(&round);
-            let mut bad: Vec<(f64, u32)> = (0..self.w.m.tets.len() as u32)
-                .filter(|&t| self.w.alive(t) && self.under_bad(t))
-                .map(|t| {
-                    (
-                        quality::min_dihedral_deg(self.w.pts(self.w.m.tets[t as usize])),
-                        t,
-                    )
-                })
-                .filter(|&(d, _)| {
-                    d < if lift {
-                        insert::LIFT_DEG
-                    } else {
-                        insert::BAD_DEG
-                    }
-                })
-                .collect();
+            let bad = self.under_deg(if lift {
+                insert::LIFT_DEG
+            } else {
+                insert::BAD_DEG
+            });
             if bad.is_empty() && round == 0 {
                 break; // none under 10°, so none under 0.1°
             }
-            bad.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
             let mut changed = 0;
             for (d0, t) in bad {
                 if !self.w.alive(t)
@@ -427,20 +419,18 @@ impl<'m> Improver<'m> {
     }
 
     /// For the share of tets under 10° (issue 5): moves, swaps, point
-    /// insertion (with `insert`), moves, swaps, moves. Measured on the
+    /// insertion, moves, swaps, moves. Measured on the
     /// tray (5,090 such tets after the passes before): moves alone leave
     /// 3,962; moves, insertion and moves 3,368; with the swaps 3,051;
     /// the same again with a second insertion 3,009 for 385 more tets.
-    fn dihedral_count_passes(&mut self, insert: bool, st: &mut ImproveStats) {
+    fn dihedral_count_passes(&mut self, st: &mut ImproveStats) {
         // One scan when there is nothing to do (the smooth parts).
         if !(0..self.w.m.tets.len() as u32).any(|t| self.w.alive(t) && self.under_bad(t)) {
             return;
         }
         self.count_pass(st);
         self.count_swap_pass(st);
-        if insert {
-            self.insert_pass(st);
-        }
+        self.insert_pass(st);
         self.count_pass(st);
         self.count_swap_pass(st);
         self.count_pass(st);
@@ -452,17 +442,7 @@ impl<'m> Improver<'m> {
     fn count_swap_pass(&mut self, st: &mut ImproveStats) {
         let t0 = Instant::now();
         for _round in 0..INSERT_ROUNDS {
-            let mut bad: Vec<(f64, u32)> = (0..self.w.m.tets.len() as u32)
-                .filter(|&t| self.w.alive(t) && self.under_bad(t))
-                .map(|t| {
-                    (
-                        quality::min_dihedral_deg(self.w.pts(self.w.m.tets[t as usize])),
-                        t,
-                    )
-                })
-                .filter(|&(d, _)| d < insert::BAD_DEG)
-                .collect();
-            bad.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+            let bad = self.under_deg(insert::BAD_DEG);
             let mut changed = 0;
             for (d0, t) in bad {
                 if !self.w.alive(t)
@@ -483,9 +463,31 @@ impl<'m> Improver<'m> {
         st.swap.seconds += t0.elapsed().as_secs_f64();
     }
 
-    /// Whether tet `t` has a dihedral angle under 10° (cheap test).
-    fn under_bad(&self, t: u32) -> bool {
-        quality::has_dihedral_under(self.w.pts(self.w.m.tets[t as usize]), TAN_BAD)
+    /// Whether tet `t` has a dihedral angle under 10° (cheap test,
+    /// cached while the tet does not change).
+    fn under_bad(&mut self, t: u32) -> bool {
+        if self.w.dok[t as usize] {
+            return false;
+        }
+        let bad = quality::has_dihedral_under(self.w.pts(self.w.m.tets[t as usize]), TAN_BAD);
+        self.w.dok[t as usize] = !bad;
+        bad
+    }
+
+    /// The live tets with a dihedral angle under `deg` (at most 10°) and
+    /// their min dihedral, worst first.
+    fn under_deg(&mut self, deg: f64) -> Vec<(f64, u32)> {
+        let mut bad = Vec::new();
+        for t in 0..self.w.m.tets.len() as u32 {
+            if self.w.alive(t) && self.under_bad(t) {
+                let d = quality::min_dihedral_deg(self.w.pts(self.w.m.tets[t as usize]));
+                if d < deg {
+                    bad.push((d, t));
+                }
+            }
+        }
+        bad.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        bad
     }
 
     /// Moves the free points of the tets under 10° to leave fewer of them
@@ -493,17 +495,7 @@ impl<'m> Improver<'m> {
     /// selective movement.
     fn count_pass(&mut self, st: &mut ImproveStats) {
         let t0 = Instant::now();
-        let mut bad: Vec<(f64, u32)> = (0..self.w.m.tets.len() as u32)
-            .filter(|&t| self.w.alive(t) && self.under_bad(t))
-            .map(|t| {
-                (
-                    quality::min_dihedral_deg(self.w.pts(self.w.m.tets[t as usize])),
-                    t,
-                )
-            })
-            .filter(|&(d, _)| d < insert::BAD_DEG)
-            .collect();
-        bad.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        let bad = self.under_deg(insert::BAD_DEG);
         let mut seen = vec![false; self.w.m.points.len()];
         for (_, t) in bad {
             for p in self.w.m.tets[t as usize] {

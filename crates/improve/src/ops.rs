@@ -349,6 +349,7 @@ impl Work<'_> {
             let v = self.m.tets[t as usize];
             self.q[t as usize] = quality(self.pts(v));
             self.tested[t as usize] = false;
+            self.dok[t as usize] = false;
             for x in v {
                 self.settled[x.idx()] = false;
             }
