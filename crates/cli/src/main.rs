@@ -499,12 +499,13 @@ fn print_summary(sum: &Summary, q: &QualityReport) {
             .map(|(n, o)| format!("{n} {}/{} in {:.3} s", o.done, o.tried, o.seconds))
             .collect();
         println!(
-            "improvement (seconds of CPU per operation, summed over parts): {} ({} 2-3, {} 3-2, {} edge removals, {} points removed)",
+            "improvement (seconds of CPU per operation, summed over parts): {} ({} 2-3, {} 3-2, {} edge removals, {} points removed, {} inserted)",
             ops.join(", "),
             st.swaps_23,
             st.swaps_32,
             st.edge_removals,
-            st.points_removed
+            st.points_removed,
+            st.points_inserted
         );
     }
     println!(

@@ -124,7 +124,7 @@ fn cut(mesh: &TetMesh, tets: &[u32], frozen: &[bool], level: u8) -> Result<Piece
         .map(|&p| frozen.get(p as usize).copied().unwrap_or(false))
         .collect();
     let mut st = ImproveStats::default();
-    let dead = run(&mut sub, &fr, level, &mut st, false)?;
+    let dead = run(&mut sub, &fr, level, &mut st, false, false)?;
     Ok(Piece {
         global,
         mesh: sub,
@@ -139,6 +139,7 @@ fn add(a: &mut ImproveStats, b: &ImproveStats) {
         (&mut a.collapse, b.collapse),
         (&mut a.smooth, b.smooth),
         (&mut a.selective, b.selective),
+        (&mut a.insert, b.insert),
     ] {
         x.tried += y.tried;
         x.done += y.done;

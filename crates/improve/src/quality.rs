@@ -46,6 +46,27 @@ pub fn min_dihedral_deg(p: [P3; 4]) -> f64 {
     m.to_degrees()
 }
 
+/// Whether a dihedral angle of the tet is under `tan_max` in tangent
+/// (and acute): `min_dihedral_deg(p) < deg` with `tan_max = tan(deg)`,
+/// without the arc tangents. At edge `e`, `|n1 x n2| = |e| |6V|`.
+pub fn has_dihedral_under(p: [P3; 4], tan_max: f64) -> bool {
+    use parafront_geom::{cross, dot, norm, sub};
+    let v6 = tet_volume6(p[0], p[1], p[2], p[3]).abs();
+    const E: [[usize; 4]; 6] = [
+        [0, 1, 2, 3],
+        [0, 2, 1, 3],
+        [0, 3, 1, 2],
+        [1, 2, 0, 3],
+        [1, 3, 0, 2],
+        [2, 3, 0, 1],
+    ];
+    E.iter().any(|&[a, b, c, d]| {
+        let e = sub(p[b], p[a]);
+        let c12 = dot(cross(e, sub(p[c], p[a])), cross(e, sub(p[d], p[a])));
+        c12 > 0.0 && norm(e) * v6 < tan_max * c12
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -74,5 +95,20 @@ mod tests {
         // The fourth point at the centroid of the first three's face.
         let flat = [r[0], r[1], r[2], [1.0 / 3.0, 1.0 / 3.0, -1.0 / 3.0]];
         assert!(min_dihedral_deg(flat) < 1e-6);
+        let t10 = 10f64.to_radians().tan();
+        assert!(has_dihedral_under(flat, t10) && !has_dihedral_under(r, t10));
+        // Wedges with a dihedral of 5° and 15° at edge 01: the cheap test
+        // agrees with the angles.
+        for deg in [5.0f64, 15.0] {
+            let a = deg.to_radians();
+            let w = [
+                [0.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [0.5, 1.0, 0.0],
+                [0.5, a.cos(), a.sin()],
+            ];
+            assert_eq!(has_dihedral_under(w, t10), min_dihedral_deg(w) < 10.0);
+            assert_eq!(has_dihedral_under(w, t10), deg < 10.0);
+        }
     }
 }

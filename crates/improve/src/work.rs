@@ -28,6 +28,9 @@ pub(crate) struct Work<'m> {
     /// changed since: smoothing it again would decide the same (§9.1's
     /// marking, applied to §9.3).
     pub settled: Vec<bool>,
+    /// Known to have no dihedral angle under 10° since it last changed
+    /// (a cache for the passes on those tets).
+    pub dok: Vec<bool>,
     free: Vec<u32>,
     stamp: Vec<u32>,
     gen: u32,
@@ -88,6 +91,7 @@ impl<'m> Work<'m> {
             p2t,
             tested: vec![false; nt],
             settled: vec![false; np],
+            dok: vec![false; nt],
             q,
             free: Vec::new(),
             stamp: vec![0; nt],
@@ -291,6 +295,7 @@ impl<'m> Work<'m> {
                 self.m.neigh.extend([NO_FACE; 4]);
                 self.q.push(f64::INFINITY);
                 self.tested.push(false);
+                self.dok.push(false);
                 (self.m.tets.len() - 1) as u32
             };
             slots.push(s);
@@ -319,6 +324,7 @@ impl<'m> Work<'m> {
             self.m.region[s] = region;
             self.q[s] = quality(self.pts(new[i]));
             self.tested[s] = false;
+            self.dok[s] = false;
             for g in 0..4 {
                 let me = FaceRef::of(parafront_mesh::TetId(s as u32), g);
                 let l = link[4 * i + g];

@@ -2,7 +2,7 @@
 //! result must be a valid mesh with the same boundary and volume, and the
 //! outcome the one the geometry calls for.
 use parafront_geom::{orient3d, tet_volume6, P3};
-use parafront_improve::quality::quality;
+use parafront_improve::quality::{min_dihedral_deg, quality};
 use parafront_improve::{Improver, Outcome};
 use parafront_mesh::{PointId, TetMesh};
 
@@ -269,4 +269,100 @@ fn smoothing_raises_the_worst_tet() {
     assert_same_domain(&m, &tr, vol);
     assert!(worst(&m) > q0);
     assert!(m.points[0][2] < 0.9);
+}
+
+fn min_dihedral(m: &TetMesh) -> f64 {
+    m.tets
+        .iter()
+        .map(|t| min_dihedral_deg(t.map(|x| m.points[x.idx()])))
+        .fold(f64::INFINITY, f64::min)
+}
+
+fn under_10(m: &TetMesh) -> usize {
+    m.tets
+        .iter()
+        .filter(|t| min_dihedral_deg(t.map(|x| m.points[x.idx()])) < 10.0)
+        .count()
+}
+
+/// Three tets from the tray (issue 5), shifted: the foot of a 3.175 high
+/// wall (points 0, 4, 5 at y = 0, 1, 2 at the top) and a point 12 away on
+/// the top face. Every tet is under 10° and no swap helps; one new point
+/// near the short edges gives tets that are all over 10°.
+fn wall_foot() -> TetMesh {
+    let pts = vec![
+        [0.0, 0.0, 0.0],
+        [-0.3068, 3.175, 0.3068],
+        [0.0, 3.175, 0.0],
+        [-5.0453, 3.175, -10.69362],
+        [0.3554, 0.0, -0.24888],
+        [-0.3068, 0.0, 0.3068],
+    ];
+    mesh(pts, &[[0, 1, 2, 3], [4, 2, 3, 0], [0, 5, 1, 3]])
+}
+
+#[test]
+fn insertion_of_a_point_at_a_wall_foot() {
+    let mut m = wall_foot();
+    let (tr, vol, d0) = (tris(&m), m.volume(), min_dihedral(&m));
+    assert_eq!(under_10(&m), 3);
+    let mut imp = Improver::new(&mut m, &[]).unwrap();
+    // The three share edge 0-3; neither its removal nor a face swap helps.
+    assert_ne!(imp.remove_edge(0, PointId(0), PointId(3)), Outcome::Done);
+    for t in 0..3 {
+        for f in 0..4 {
+            assert_ne!(imp.swap_face(t, f), Outcome::Done);
+        }
+    }
+    assert_eq!(imp.insert_point(0, false), Outcome::Done);
+    assert!(imp.is_free(PointId(6)));
+    imp.finish();
+    m.check().unwrap();
+    // The same boundary (every old point is on it), one more point.
+    assert_same_domain(&m, &tr, vol);
+    assert_eq!(m.points.len(), 7);
+    assert!(m.tets.iter().all(|t| t.contains(&PointId(6))));
+    assert_eq!(under_10(&m), 0);
+    assert!(min_dihedral(&m) > d0);
+}
+
+#[test]
+fn insertion_refused_when_nothing_gets_better() {
+    // The regular-ish tets of a ring: none under 10°, nothing to gain.
+    let mut m = ring_mesh(5, 1.0);
+    assert_eq!(under_10(&m), 0);
+    let before = m.clone();
+    let mut imp = Improver::new(&mut m, &[]).unwrap();
+    assert_eq!(imp.insert_point(0, false), Outcome::NotBetter);
+    assert_eq!(imp.insert_point(99, false), Outcome::NotFound);
+    imp.finish();
+    assert_eq!(m.tets, before.tets);
+    assert_eq!(m.points, before.points);
+}
+
+#[test]
+fn swap_for_the_dihedral_angles() {
+    // Two flat tets on a wide triangle, both under 10°: the 2-3 swap
+    // leaves none under 10°.
+    let s = 3f64.sqrt() / 2.0;
+    let pts = vec![
+        [1.0, 0.0, 0.0],
+        [-0.5, s, 0.0],
+        [-0.5, -s, 0.0],
+        [0.0, 0.0, -0.06],
+        [0.0, 0.0, 0.06],
+    ];
+    let mut m = mesh(pts, &[[0, 1, 2, 4], [0, 2, 1, 3]]);
+    let (tr, vol, d0) = (tris(&m), m.volume(), min_dihedral(&m));
+    assert_eq!(under_10(&m), 2);
+    let mut imp = Improver::new(&mut m, &[]).unwrap();
+    assert_eq!(imp.swap_for_dihedral(0), Outcome::Done);
+    // Now nothing under 10° is left around tet 0.
+    assert_eq!(imp.swap_for_dihedral(0), Outcome::NotBetter);
+    imp.finish();
+    m.check().unwrap();
+    assert_eq!(m.tets.len(), 3);
+    assert_same_domain(&m, &tr, vol);
+    assert_eq!(under_10(&m), 0);
+    assert!(min_dihedral(&m) > d0);
 }

@@ -1,0 +1,467 @@
+//! Steiner point insertion, an addition to §9 (the paper's improver only
+//! swaps, collapses and moves): a new free point `p` replaces a small
+//! cavity around a tet with small dihedral angles by the star of `p` over
+//! the cavity's outer faces. Boundary faces stay faces of the new tets,
+//! so the surface is untouched. Cavities: the tet and one neighbour, the
+//! tet and all its neighbours, the ring of one of its edges (a point
+//! inside the tet alone never helped on the tray). The point starts at the best of a few candidates (the centroid,
+//! edge midpoints, points at the short edge's distance around the
+//! shortest edge: the apex of a needle tet) and a compass search moves it.
+//!
+//! Dihedral angles are the point here, not the mean ratio: a needle tet
+//! (a short edge, the other points far) can have good dihedral angles but
+//! has a low mean ratio. A candidate is kept only when the cavity ends
+//! with fewer tets under [`BAD_DEG`] and a min dihedral no lower; or, for
+//! a tet under [`LIFT_DEG`], when the cavity's min dihedral rises.
+use crate::ops::{positive, Cand, MARGIN};
+use crate::quality::{min_dihedral_deg, quality};
+use crate::work::Work;
+use parafront_geom::{cross, dist2, norm, sub, P3};
+use parafront_mesh::quality::TET_EDGES;
+use parafront_mesh::{PointId, TET_FACES};
+
+/// A tet with a min dihedral under this many degrees is bad (the issue's
+/// measure).
+pub(crate) const BAD_DEG: f64 = 10.0;
+/// Tets under this min dihedral (degrees) may get a point that only lifts
+/// the min dihedral of their cavity, even at the cost of more tets under
+/// [`BAD_DEG`] (the worst tet is the first criterion).
+pub(crate) const LIFT_DEG: f64 = 0.1;
+/// The min dihedral (degrees) a lift aims at before it minds the count.
+const LIFT_GOAL: f64 = 0.2;
+/// Cavity kinds ([`Work::cavity`]).
+const CAVITIES: usize = 11;
+/// Largest cavity (tets) considered.
+const MAX_CAVITY: usize = 12;
+
+/// Scratch of the insertion.
+#[derive(Default)]
+pub(crate) struct InsScratch {
+    cav: Vec<u32>,
+    /// Outer faces as (tet vertices, local index the new point takes).
+    star: Vec<([PointId; 4], usize)>,
+    best_cav: Vec<u32>,
+    best_star: Vec<([PointId; 4], usize)>,
+    tets: Vec<u32>,
+    ring: Vec<PointId>,
+    pts: Vec<PointId>,
+}
+
+/// How good a star is: tets under [`BAD_DEG`], summed shortfall below
+/// 12° (what the search minimises after the count), min dihedral and min
+/// mean ratio.
+#[derive(Clone, Copy, Debug)]
+struct Score {
+    under: usize,
+    short: f64,
+    dmin: f64,
+    qmin: f64,
+}
+
+impl Score {
+    /// What the search minimises: the count under [`BAD_DEG`] then the
+    /// shortfall; with `lift` (a tet under [`LIFT_DEG`]) first the min
+    /// dihedral up to [`LIFT_GOAL`].
+    /// Relative to the cavity's tets before (`old`), so that cavities of
+    /// different sizes compare.
+    fn key(&self, old: &Score, lift: bool) -> (f64, isize, f64) {
+        let d = if lift { -self.dmin.min(LIFT_GOAL) } else { 0.0 };
+        (
+            d,
+            self.under as isize - old.under as isize,
+            self.short - old.short,
+        )
+    }
+}
+
+fn less(a: (f64, isize, f64), b: (f64, isize, f64)) -> bool {
+    a.0 < b.0 - 1e-12 || (a.0 <= b.0 && (a.1 < b.1 || (a.1 == b.1 && a.2 < b.2 - 1e-9)))
+}
+
+impl Work<'_> {
+    /// Fills `s.star` with the outer faces of `s.cav`; false when the
+    /// cavity is not one region, holds a point in its interior (every
+    /// point must stay on an outer face) or is too large.
+    fn star_of(&self, s: &mut InsScratch) -> bool {
+        s.star.clear();
+        if s.cav.len() > MAX_CAVITY {
+            return false;
+        }
+        let region = self.m.region[s.cav[0] as usize];
+        for &t in &s.cav {
+            if self.m.region[t as usize] != region {
+                return false;
+            }
+            let v = self.m.tets[t as usize];
+            for f in 0..4 {
+                let n = self.m.neigh[4 * t as usize + f];
+                if !n.is_none() && s.cav.contains(&n.tet().0) {
+                    continue;
+                }
+                s.star.push((v, f));
+            }
+        }
+        s.pts.clear();
+        for &t in &s.cav {
+            for p in self.m.tets[t as usize] {
+                if !s.pts.contains(&p) {
+                    s.pts.push(p);
+                }
+            }
+        }
+        s.pts.iter().all(|&p| {
+            s.star
+                .iter()
+                .any(|(v, f)| TET_FACES[*f].iter().any(|&l| v[l] == p))
+        })
+    }
+
+    fn score_star(&self, star: &[([PointId; 4], usize)], pos: P3) -> Option<Score> {
+        let mut sc = Score {
+            under: 0,
+            short: 0.0,
+            dmin: f64::INFINITY,
+            qmin: f64::INFINITY,
+        };
+        for &(v, f) in star {
+            let mut x = self.pts(v);
+            x[f] = pos;
+            if !positive(x) {
+                return None;
+            }
+            let d = min_dihedral_deg(x);
+            sc.under += usize::from(d < BAD_DEG);
+            sc.short += (12.0 - d).max(0.0);
+            sc.dmin = sc.dmin.min(d);
+            sc.qmin = sc.qmin.min(quality(x));
+        }
+        Some(sc)
+    }
+
+    /// Cavity `k` of tet `t` into `s.cav`: 0-3 the tet and its neighbour
+    /// across face k, 4 the tet and all its neighbours, 5-10 the ring of
+    /// edge k-5. False when it does not exist.
+    fn cavity(&self, t: u32, k: usize, s: &mut InsScratch) -> bool {
+        s.cav.clear();
+        s.cav.push(t);
+        match k {
+            0..=3 => match self.free_neighbour(t, k) {
+                Some(n) => {
+                    s.cav.push(n.tet().0);
+                    true
+                }
+                None => false,
+            },
+            4 => {
+                for f in 0..4 {
+                    if let Some(n) = self.free_neighbour(t, f) {
+                        if !s.cav.contains(&n.tet().0) {
+                            s.cav.push(n.tet().0);
+                        }
+                    }
+                }
+                s.cav.len() > 2
+            }
+            _ => {
+                let v = self.m.tets[t as usize];
+                let e = TET_EDGES[k - 5];
+                if self
+                    .ring(t, v[e[0]], v[e[1]], &mut s.tets, &mut s.ring)
+                    .is_none()
+                {
+                    return false;
+                }
+                s.cav.clear();
+                s.cav.extend_from_slice(&s.tets);
+                true
+            }
+        }
+    }
+
+    /// Old cavity's score from the stored tets.
+    fn score_old(&self, cav: &[u32]) -> Score {
+        let mut sc = Score {
+            under: 0,
+            short: 0.0,
+            dmin: f64::INFINITY,
+            qmin: f64::INFINITY,
+        };
+        for &t in cav {
+            let d = min_dihedral_deg(self.pts(self.m.tets[t as usize]));
+            sc.under += usize::from(d < BAD_DEG);
+            sc.short += (12.0 - d).max(0.0);
+            sc.dmin = sc.dmin.min(d);
+            sc.qmin = sc.qmin.min(self.q[t as usize]);
+        }
+        sc
+    }
+
+    /// Evaluates inserting a point around bad tet `t`; on success `c`
+    /// holds the replacement (the new point's id is `m.points.len()`) and
+    /// the point's position is returned.
+    pub(crate) fn eval_insert(
+        &self,
+        t: u32,
+        lift: bool,
+        s: &mut InsScratch,
+        c: &mut Cand,
+    ) -> Result<P3, crate::Outcome> {
+        use crate::Outcome;
+        let v = self.m.tets[t as usize];
+        let x = self.pts(v);
+        // Candidate points.
+        let mut cands: Vec<P3> = Vec::with_capacity(24);
+        let cen = [0, 1, 2].map(|k| 0.25 * (x[0][k] + x[1][k] + x[2][k] + x[3][k]));
+        cands.push(cen);
+        let mut short = (f64::INFINITY, 0);
+        for (i, e) in TET_EDGES.iter().enumerate() {
+            let (a, b) = (x[e[0]], x[e[1]]);
+            cands.push([0, 1, 2].map(|k| 0.5 * (a[k] + b[k])));
+            let l = dist2(a, b);
+            if l < short.0 {
+                short = (l, i);
+            }
+        }
+        // Around the shortest edge, at its length: a needle tet's apex.
+        let e = TET_EDGES[short.1];
+        let (a, b) = (x[e[0]], x[e[1]]);
+        let l = short.0.sqrt();
+        let m = [0, 1, 2].map(|k| 0.5 * (a[k] + b[k]));
+        let ab = sub(b, a);
+        let oth: Vec<P3> = (0..4)
+            .filter(|&i| i != e[0] && i != e[1])
+            .map(|i| x[i])
+            .collect();
+        for o in &oth {
+            let n = cross(ab, sub(*o, a));
+            let u = cross(n, ab);
+            let nu = norm(u);
+            if nu > 0.0 {
+                for f in [0.5, 0.87, 1.5] {
+                    cands.push([0, 1, 2].map(|k| m[k] + f * l * u[k] / nu));
+                }
+            }
+        }
+        let lift = lift && min_dihedral_deg(x) < LIFT_DEG;
+        let mut best: Option<(Score, Score, P3)> = None;
+        for k in 0..CAVITIES {
+            if !self.cavity(t, k, s) || !self.star_of(s) {
+                continue;
+            }
+            let old = self.score_old(&s.cav);
+            for &p in &cands {
+                if let Some(sc) = self.score_star(&s.star, p) {
+                    if best
+                        .as_ref()
+                        .is_none_or(|b| less(sc.key(&old, lift), b.0.key(&b.1, lift)))
+                    {
+                        best = Some((sc, old, p));
+                        s.best_star.clear();
+                        s.best_star.extend_from_slice(&s.star);
+                        s.best_cav.clear();
+                        s.best_cav.extend_from_slice(&s.cav);
+                    }
+                }
+            }
+        }
+        let Some((mut sc, old, mut pos)) = best else {
+            return Err(Outcome::Inverted);
+        };
+        // Compass search on the chosen cavity.
+        let len = s
+            .best_star
+            .iter()
+            .map(|(v, f)| {
+                let q = self.m.points[v[TET_FACES[*f][0]].idx()];
+                dist2(q, pos).sqrt()
+            })
+            .fold(f64::INFINITY, f64::min);
+        let mut step = 0.3 * len;
+        // Lifting the worst tet needs a finer search (they are few).
+        let (iters, stop) = if lift { (60, 1e-4) } else { (20, 1e-2) };
+        for _ in 0..iters {
+            if step < stop * len {
+                break;
+            }
+            let mut moved = None;
+            for dir in crate::ops::DIRS {
+                let p = [0, 1, 2].map(|k| pos[k] + step * dir[k]);
+                if let Some(n) = self.score_star(&s.best_star, p) {
+                    let cur = moved.as_ref().map_or(&sc, |m: &(Score, P3)| &m.0);
+                    if less(n.key(&old, lift), cur.key(&old, lift)) {
+                        moved = Some((n, p));
+                    }
+                }
+            }
+            match moved {
+                Some((n, p)) => {
+                    sc = n;
+                    pos = p;
+                }
+                None => step *= 0.5,
+            }
+        }
+        let ok = (sc.under < old.under && sc.dmin >= old.dmin)
+            || (lift && sc.dmin > old.dmin * (1.0 + MARGIN) + 1e-9);
+        if !ok {
+            return Err(Outcome::NotBetter);
+        }
+        let np = PointId::new(self.m.points.len());
+        c.old.clear();
+        c.old.extend_from_slice(&s.best_cav);
+        c.new.clear();
+        c.new.extend(s.best_star.iter().map(|&(mut v, f)| {
+            v[f] = np;
+            v
+        }));
+        c.qmin = sc.qmin;
+        Ok(pos)
+    }
+
+    /// Appends a free point at `pos` (for an insertion about to commit).
+    pub(crate) fn push_point(&mut self, pos: P3) -> PointId {
+        self.m.points.push(pos);
+        self.frozen.push(false);
+        self.dead_pt.push(false);
+        self.p2t.push(u32::MAX);
+        self.settled.push(false);
+        PointId::new(self.m.points.len() - 1)
+    }
+}
+
+/// Cost of a new tet for the count swaps: 1000 if under [`BAD_DEG`],
+/// plus its shortfall below 12°; `None` when not positive. Also its min
+/// dihedral.
+fn cost(x: [P3; 4]) -> Option<(f64, f64)> {
+    if !positive(x) {
+        return None;
+    }
+    let d = min_dihedral_deg(x);
+    let bad = if d < BAD_DEG { 1000.0 } else { 0.0 };
+    Some((bad + (12.0 - d).max(0.0), d))
+}
+
+impl Work<'_> {
+    /// Swaps for the dihedral count (§9.1's 2-3 and edge removal, judged
+    /// as the insertion is): the best of the 4 face swaps and 6 edge
+    /// removals of tet `t` that leaves fewer tets under [`BAD_DEG`] and a
+    /// min dihedral no lower. Edge removal takes the triangulation of the
+    /// ring with the least summed cost (Klincsek's programme on a sum).
+    pub(crate) fn eval_count_swap(
+        &self,
+        t: u32,
+        s: &mut InsScratch,
+        c: &mut Cand,
+    ) -> crate::Outcome {
+        use crate::Outcome;
+        let v = self.m.tets[t as usize];
+        // (cost change, under, dmin) of the best candidate so far.
+        let mut best: Option<(f64, usize, f64)> = None;
+        let mut found = Outcome::NotBetter;
+        for f in 0..4 {
+            let Some(n) = self.free_neighbour(t, f) else {
+                continue;
+            };
+            let nt = n.tet().0;
+            let e = self.m.tets[nt as usize][n.local()];
+            let d = v[f];
+            let [a, b, cc] = TET_FACES[f].map(|l| v[l]);
+            let new = [[d, e, a, b], [d, e, b, cc], [d, e, cc, a]];
+            s.cav.clear();
+            s.cav.extend([t, nt]);
+            let old = self.score_old(&s.cav);
+            let mut sum = 0.0;
+            let mut under = 0;
+            let mut dmin = f64::INFINITY;
+            let mut ok = true;
+            for nv in new {
+                match cost(self.pts(nv)) {
+                    Some((k, dd)) => {
+                        sum += k;
+                        under += usize::from(dd < BAD_DEG);
+                        dmin = dmin.min(dd);
+                    }
+                    None => ok = false,
+                }
+            }
+            let gain = sum - (1000.0 * old.under as f64 + old.short);
+            if ok && under < old.under && dmin >= old.dmin && best.is_none_or(|b| gain < b.0) {
+                best = Some((gain, under, dmin));
+                c.old.clear();
+                c.old.extend([t, nt]);
+                c.new.clear();
+                c.new.extend(new);
+                found = Outcome::Done;
+            }
+        }
+        for e in TET_EDGES {
+            let (a, b) = (v[e[0]], v[e[1]]);
+            if self.ring(t, a, b, &mut s.tets, &mut s.ring).is_none() {
+                continue;
+            }
+            s.cav.clear();
+            s.cav.extend_from_slice(&s.tets);
+            let old = self.score_old(&s.cav);
+            let n = s.ring.len();
+            let (pa, pb) = (self.m.points[a.idx()], self.m.points[b.idx()]);
+            let r: Vec<P3> = s.ring.iter().map(|p| self.m.points[p.idx()]).collect();
+            // dp[i][j]: (cost, k, under, dmin) of the best triangulation of
+            // the ring polygon i..j.
+            const N: usize = crate::work::MAX_RING;
+            let mut dp = [[(0.0f64, 0usize, 0usize, f64::INFINITY); N]; N];
+            for len in 2..n {
+                for i in 0..n - len {
+                    let j = i + len;
+                    let mut bk = (f64::INFINITY, 0, 0, 0.0);
+                    for k in i + 1..j {
+                        let (l, rr) = (dp[i][k], dp[k][j]);
+                        if l.0 + rr.0 >= bk.0 {
+                            continue;
+                        }
+                        let (Some(t1), Some(t2)) =
+                            (cost([r[i], r[k], r[j], pb]), cost([r[i], r[j], r[k], pa]))
+                        else {
+                            continue;
+                        };
+                        let sum = l.0 + rr.0 + t1.0 + t2.0;
+                        if sum < bk.0 {
+                            let under = l.2
+                                + rr.2
+                                + usize::from(t1.1 < BAD_DEG)
+                                + usize::from(t2.1 < BAD_DEG);
+                            bk = (sum, k, under, l.3.min(rr.3).min(t1.1).min(t2.1));
+                        }
+                    }
+                    dp[i][j] = bk;
+                }
+            }
+            let (sum, _, under, dmin) = dp[0][n - 1];
+            let gain = sum - (1000.0 * old.under as f64 + old.short);
+            if !sum.is_finite()
+                || under >= old.under
+                || dmin < old.dmin
+                || best.is_some_and(|b| gain >= b.0)
+            {
+                continue;
+            }
+            best = Some((gain, under, dmin));
+            c.new.clear();
+            let mut stack = vec![(0usize, n - 1)];
+            while let Some((i, j)) = stack.pop() {
+                if j - i < 2 {
+                    continue;
+                }
+                let k = dp[i][j].1;
+                let (ri, rk, rj) = (s.ring[i], s.ring[k], s.ring[j]);
+                c.new.push([ri, rk, rj, b]);
+                c.new.push([ri, rj, rk, a]);
+                stack.push((i, k));
+                stack.push((k, j));
+            }
+            c.old.clear();
+            c.old.extend_from_slice(&s.tets);
+            found = Outcome::Done;
+        }
+        found
+    }
+}
