@@ -1080,23 +1080,18 @@ impl<'a> Front<'a> {
             // crossing a hair apart leave a slab between their faces that
             // only slivers fill (thin plates of CAD needles).
             if em > 0.0 && !planes.clear_of(gp, em) {
-                for e in 0..3 {
-                    if !ebox[e].overlaps(&nf.bb) {
-                        continue;
+                // Front edge k against new edge e = (tv[e], q), by the tet's
+                // local indices: one front edge's box serves all three.
+                for k in 0..3 {
+                    let (l0, l1) = (gl[k], gl[(k + 1) % 3]);
+                    if l0 == 3 || l1 == 3 || (l0 < 4 && l1 < 4) {
+                        continue; // ends at the apex, or an edge of the tet
                     }
-                    let a = tv[e];
-                    for k in 0..3 {
-                        let (g0, g1) = (g[k], g[(k + 1) % 3]);
-                        if g0 == a || g1 == a || g0 == q || g1 == q {
-                            continue;
-                        }
-                        if tv.contains(&g0) && tv.contains(&g1) {
-                            continue; // an edge of the tet itself
-                        }
-                        let (x0, x1) = (gp[k], gp[(k + 1) % 3]);
-                        let mut sb = Aabb { min: x0, max: x0 };
-                        sb.grow(x1);
-                        if !ebox[e].overlaps(&sb) {
+                    let (x0, x1) = (gp[k], gp[(k + 1) % 3]);
+                    let mut sb = Aabb { min: x0, max: x0 };
+                    sb.grow(x1);
+                    for e in 0..3 {
+                        if l0 == e || l1 == e || !ebox[e].overlaps(&sb) {
                             continue;
                         }
                         if segment_segment_dist2(tp[e], pq, x0, x1) < em * em {
