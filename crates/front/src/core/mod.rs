@@ -420,12 +420,25 @@ fn box_dist2(b: &Aabb, p: P3) -> f64 {
     d2
 }
 
-fn tri_box(p: &[P3], v: [u32; 3]) -> Aabb {
-    let mut b = Aabb::EMPTY;
-    for &i in &v {
-        b.grow(p[i as usize]);
+/// The box of `N >= 1` points, by compare and select (`minsd`, where
+/// `f64::min` adds a NaN fix-up): the same box but for the sign of a zero.
+#[inline(always)]
+fn bbox<const N: usize>(p: [P3; N]) -> Aabb {
+    let mut b = Aabb {
+        min: p[0],
+        max: p[0],
+    };
+    for x in &p[1..] {
+        for k in 0..3 {
+            b.min[k] = if x[k] < b.min[k] { x[k] } else { b.min[k] };
+            b.max[k] = if x[k] > b.max[k] { x[k] } else { b.max[k] };
+        }
     }
     b
+}
+
+fn tri_box(p: &[P3], v: [u32; 3]) -> Aabb {
+    bbox(v.map(|i| p[i as usize]))
 }
 
 /// Fill the region bounded by `input.faces` (paper AF1-AF5).
@@ -581,10 +594,7 @@ impl<'a> Front<'a> {
         self.fgrid.query(q, |g| {
             let w = self.fv[g as usize];
             let p = w.map(|i| self.pts[i as usize]);
-            let mut bb = Aabb::EMPTY;
-            for x in p {
-                bb.grow(x);
-            }
+            let bb = bbox(p);
             if !bb.overlaps(q) {
                 return;
             }
@@ -1032,10 +1042,7 @@ impl<'a> Front<'a> {
             self.pts[v[2] as usize],
             pq,
         ];
-        let mut tb = Aabb::EMPTY;
-        for p in tp {
-            tb.grow(p);
-        }
+        let tb = bbox(tp);
         // The three new faces, built once rather than per near face.
         let nfv: [[u32; 3]; 3] = [0, 1, 2].map(|i| TET_FACES[i].map(|k| tv[k]));
         let nfp: [[P3; 3]; 3] = [0, 1, 2].map(|i| TET_FACES[i].map(|k| tp[k]));
@@ -1049,14 +1056,7 @@ impl<'a> Front<'a> {
         let tb_clear = tb.inflated(m_apex.max(em));
         // The new edges' boxes, grown by the edge clearance: a front edge
         // whose box misses one is farther than that from the edge.
-        let ebox: [Aabb; 3] = [0, 1, 2].map(|e| {
-            let mut b = Aabb {
-                min: tp[e],
-                max: tp[e],
-            };
-            b.grow(pq);
-            b.inflated(em)
-        });
+        let ebox: [Aabb; 3] = [0, 1, 2].map(|e| bbox([tp[e], pq]).inflated(em));
         for nf in near_f {
             if !nf.bb.overlaps(&tb_clear) {
                 continue;
@@ -1088,8 +1088,7 @@ impl<'a> Front<'a> {
                         continue; // ends at the apex, or an edge of the tet
                     }
                     let (x0, x1) = (gp[k], gp[(k + 1) % 3]);
-                    let mut sb = Aabb { min: x0, max: x0 };
-                    sb.grow(x1);
+                    let sb = bbox([x0, x1]);
                     for e in 0..3 {
                         if l0 == e || l1 == e || !ebox[e].overlaps(&sb) {
                             continue;
