@@ -64,6 +64,15 @@ fn cell_key(c: [i64; 3]) -> u64 {
     ((c[0] as u64) & m) | (((c[1] as u64) & m) << 21) | (((c[2] as u64) & m) << 42)
 }
 
+/// `x.floor() as i64` without a call to libm's `floor` (x86-64 has no
+/// rounding instruction before SSE4.1): truncate, then step down for a
+/// negative fraction; saturates as `as` does.
+#[inline]
+fn floor_i64(x: f64) -> i64 {
+    let t = x as i64;
+    t.saturating_sub(((t as f64) > x) as i64)
+}
+
 #[inline]
 fn down(x: f64) -> f32 {
     let y = x as f32;
@@ -116,11 +125,7 @@ impl LooseGrid {
 
     #[inline]
     fn cell_of(&self, p: P3, cell: f64) -> [i64; 3] {
-        [
-            ((p[0] - self.origin[0]) / cell).floor() as i64,
-            ((p[1] - self.origin[1]) / cell).floor() as i64,
-            ((p[2] - self.origin[2]) / cell).floor() as i64,
-        ]
+        [0, 1, 2].map(|k| floor_i64((p[k] - self.origin[k]) / cell))
     }
 
     /// Level and cell key of an item with box `b`.
@@ -272,6 +277,18 @@ mod tests {
             .collect();
         v.sort();
         v
+    }
+
+    #[test]
+    fn floor_i64_is_floor() {
+        for x in [
+            0.0, -0.0, 0.5, -0.5, 1.0, -1.0, -1.5, 2.75, -2.75, 1e30, -1e30, 9.3e18, -9.3e18,
+        ] {
+            assert_eq!(floor_i64(x), x.floor() as i64, "{x}");
+        }
+        for x in [f64::INFINITY, f64::NEG_INFINITY, f64::NAN] {
+            assert_eq!(floor_i64(x), x.floor() as i64, "{x}");
+        }
     }
 
     #[test]

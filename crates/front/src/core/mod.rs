@@ -414,7 +414,10 @@ fn heap_entry(key: f64, face: u32) -> Reverse<u64> {
 fn box_dist2(b: &Aabb, p: P3) -> f64 {
     let mut d2 = 0.0;
     for k in 0..3 {
-        let d = (b.min[k] - p[k]).max(p[k] - b.max[k]).max(0.0);
+        // Compare and select, as in `bbox`.
+        let (lo, hi) = (b.min[k] - p[k], p[k] - b.max[k]);
+        let d = if lo > hi { lo } else { hi };
+        let d = if d > 0.0 { d } else { 0.0 };
         d2 += d * d;
     }
     d2
