@@ -363,7 +363,9 @@ impl SeparatingPlanes {
     /// keeps at least `margin` from the tet.
     #[inline]
     fn clear_of(&self, g: &[P3; 3], margin: f64) -> bool {
-        (0..4).any(|i| {
+        // The base plane first: front faces around the base face lie
+        // mostly under it (any order gives the same answer).
+        [3, 0, 1, 2].into_iter().any(|i| {
             g.iter()
                 .all(|&x| dot(self.n[i], sub(x, self.o[i])) * self.inv_len[i] > margin)
         })
@@ -380,7 +382,8 @@ impl SeparatingPlanes {
     /// strictly outside leaves `g` meeting the tet in shared corners only.
     #[inline]
     fn separates(&self, g: &[P3; 3], gl: [usize; 3]) -> bool {
-        'planes: for i in 0..4 {
+        // The base plane first, as in `clear_of`.
+        'planes: for i in [3, 0, 1, 2] {
             let mut outside = 0;
             for j in 0..3 {
                 if gl[j] < 4 {
@@ -391,6 +394,9 @@ impl SeparatingPlanes {
                 }
                 let d = sub(g[j], self.o[i]);
                 let s = dot(self.n[i], d);
+                if s <= 0.0 {
+                    continue 'planes; // under any error bound
+                }
                 let err = 1e-12 * self.nn[i] * (d[0].abs() + d[1].abs() + d[2].abs());
                 if s <= err {
                     continue 'planes;
