@@ -1109,12 +1109,15 @@ impl<'a> Front<'a> {
                 }
             }
             let apart = planes.separates(gp, gl);
-            if apart && gl == [4; 3] {
-                continue; // no shared corner: no matching face, no wedge
+            // Corners shared with the tet; new face i has all its corners
+            // but corner i.
+            let nsh = gl.iter().filter(|&&l| l < 4).count();
+            if apart && nsh < 2 {
+                continue; // no common edge: no matching face, no wedge
             }
             for i in 0..3 {
                 let fvid = nfv[i];
-                let shared = fvid.iter().filter(|x| g.contains(x)).count();
+                let shared = nsh - gl.contains(&i) as usize;
                 if shared == 3 {
                     // A matching face must face the other way (AF5).
                     if same_cycle(fvid, g) {
