@@ -214,8 +214,8 @@ impl LooseGrid {
                 let mut n = 0;
                 for e in chunk {
                     let mut hit = true;
-                    for k in 0..8 {
-                        hit &= e.key[k] <= qk[k];
+                    for (a, b) in e.key.iter().zip(&qk) {
+                        hit &= a <= b;
                     }
                     buf[n & 63] = e.id;
                     n += hit as usize;

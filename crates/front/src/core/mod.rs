@@ -438,9 +438,9 @@ fn bbox<const N: usize>(p: [P3; N]) -> Aabb {
         max: p[0],
     };
     for x in &p[1..] {
-        for k in 0..3 {
-            b.min[k] = if x[k] < b.min[k] { x[k] } else { b.min[k] };
-            b.max[k] = if x[k] > b.max[k] { x[k] } else { b.max[k] };
+        for (k, &c) in x.iter().enumerate() {
+            b.min[k] = if c < b.min[k] { c } else { b.min[k] };
+            b.max[k] = if c > b.max[k] { c } else { b.max[k] };
         }
     }
     b
