@@ -336,7 +336,7 @@ fn thin_wedge(f: [u32; 3], fp: [P3; 3], g: [u32; 3], gp: [P3; 3], min: f64) -> b
 struct SeparatingPlanes {
     o: [P3; 4],
     n: [P3; 4],
-    nn: [f64; 4],
+    tol: [f64; 4],
     inv_len: [f64; 4],
 }
 
@@ -345,7 +345,7 @@ impl SeparatingPlanes {
     fn new(tp: &[P3; 4]) -> SeparatingPlanes {
         let mut o = [[0.0; 3]; 4];
         let mut n = [[0.0; 3]; 4];
-        let mut nn = [0.0; 4];
+        let mut tol = [0.0; 4];
         let mut inv_len = [0.0; 4];
         for (i, f) in TET_FACES.iter().enumerate() {
             let (a, b, c) = (tp[f[0]], tp[f[1]], tp[f[2]]);
@@ -353,10 +353,11 @@ impl SeparatingPlanes {
             let v = cross(sub(b, a), sub(c, a));
             o[i] = a;
             n[i] = v;
-            nn[i] = v[0].abs() + v[1].abs() + v[2].abs();
+            // The factor of `separates`' error bound, multiplied first there.
+            tol[i] = 1e-12 * (v[0].abs() + v[1].abs() + v[2].abs());
             inv_len[i] = 1.0 / norm(v).max(1e-300);
         }
-        SeparatingPlanes { o, n, nn, inv_len }
+        SeparatingPlanes { o, n, tol, inv_len }
     }
 
     /// Some face plane has all of `g` more than `margin` outside it: `g`
@@ -397,7 +398,7 @@ impl SeparatingPlanes {
                 if s <= 0.0 {
                     continue 'planes; // under any error bound
                 }
-                let err = 1e-12 * self.nn[i] * (d[0].abs() + d[1].abs() + d[2].abs());
+                let err = self.tol[i] * (d[0].abs() + d[1].abs() + d[2].abs());
                 if s <= err {
                     continue 'planes;
                 }
