@@ -308,16 +308,17 @@ fn thin_wedge(f: [u32; 3], fp: [P3; 3], g: [u32; 3], gp: [P3; 3], min: f64) -> b
     };
     let u = perp(fp[i]);
     let w = perp(gp[j]);
+    let x = dot(w, u);
+    if x < 0.0 {
+        return false; // an open wedge, the usual case: no normal needed
+    }
     let n = normalize(tri_normal(fp[0], fp[1], fp[2]));
-    let (y, x) = (dot(w, n), dot(w, u));
+    let y = dot(w, n);
     // On the tet's side, a tiny angle means two near-coplanar faces whose
     // crossing the exact test may see as a miss by rounding (a flat quad
     // cut by both diagonals). For x > 0 and min <= 0.1, |atan2(y, x)| < min
     // iff |y|/x < tan(min), in [min, min (1 + min^2 / 2)]: atan2 (slow)
     // decides only in between.
-    if x < 0.0 {
-        return false;
-    }
     if x > 0.0 && min <= 0.1 {
         let r = y.abs() / x;
         if r < min * (1.0 - 1e-9) {
