@@ -1057,6 +1057,9 @@ impl<'a> Front<'a> {
         // The three new faces, built once rather than per near face.
         let nfv: [[u32; 3]; 3] = [0, 1, 2].map(|i| TET_FACES[i].map(|k| tv[k]));
         let nfp: [[P3; 3]; 3] = [0, 1, 2].map(|i| TET_FACES[i].map(|k| tp[k]));
+        // Their boxes: closed triangles with no common corner and apart
+        // boxes cannot meet (exact, the boxes are of the coordinates).
+        let nfb: [Aabb; 3] = nfp.map(bbox);
         let planes = SeparatingPlanes::new(&tp);
         let m_apex = if is_new_point(q) {
             cl.new_point.max(margin)
@@ -1130,7 +1133,7 @@ impl<'a> Front<'a> {
                 if shared == 2 && cl.wedge > 0.0 && thin_wedge(fvid, nfp[i], g, *gp, cl.wedge) {
                     return false;
                 }
-                if apart {
+                if apart || (shared == 0 && !nfb[i].overlaps(&nf.bb)) {
                     continue;
                 }
                 let (fp, gq) = shared_first(fvid, nfp[i], g, *gp);
