@@ -1113,10 +1113,13 @@ impl<'a> Front<'a> {
                     }
                 }
             }
-            let apart = planes.separates(gp, gl);
             // Corners shared with the tet; new face i has all its corners
             // but corner i.
             let nsh = gl.iter().filter(|&&l| l < 4).count();
+            if nsh == 0 && !tb.overlaps(&nf.bb) {
+                continue; // nothing in common with the tet, not even its box
+            }
+            let apart = planes.separates(gp, gl);
             if apart && nsh < 2 {
                 continue; // no common edge: no matching face, no wedge
             }
