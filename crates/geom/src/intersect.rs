@@ -357,6 +357,14 @@ fn tri_tri_vertex(t1: [P3; 3], t2: [P3; 3]) -> bool {
     if a[0] * a[1] > 0 {
         return false;
     }
+    // The same test the other way round, before the projection axes
+    // (t2 in t1's plane takes b = [0, 0] below).
+    if a != [0, 0] {
+        let b = [1, 2].map(|i| o3(t2[0], t2[1], t2[2], t1[i]));
+        if b[0] * b[1] > 0 {
+            return false;
+        }
+    }
     let p1 = plane_axis(t1[0], t1[1], t1[2]);
     let p2 = plane_axis(t2[0], t2[1], t2[2]);
     let b = if a == [0, 0] && p1.is_some() {
@@ -412,6 +420,11 @@ fn tri_tri_vertex(t1: [P3; 3], t2: [P3; 3]) -> bool {
 /// Common edge `t1[0]t1[1] == t2[0]t2[1]`.
 fn tri_tri_edge(t1: [P3; 3], t2: [P3; 3]) -> bool {
     let (u, v, x, y) = (t1[0], t1[1], t1[2], t2[2]);
+    // Four points off one plane: neither triangle is flat, nor folded
+    // onto the other (the first case below), so they meet in uv only.
+    if o3(u, v, x, y) != 0 {
+        return false;
+    }
     let d1 = is_collinear(u, v, x);
     let d2 = is_collinear(u, v, y);
     match (d1, d2) {

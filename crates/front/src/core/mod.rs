@@ -308,16 +308,17 @@ fn thin_wedge(f: [u32; 3], fp: [P3; 3], g: [u32; 3], gp: [P3; 3], min: f64) -> b
     };
     let u = perp(fp[i]);
     let w = perp(gp[j]);
+    let x = dot(w, u);
+    if x < 0.0 {
+        return false; // an open wedge, the usual case: no normal needed
+    }
     let n = normalize(tri_normal(fp[0], fp[1], fp[2]));
-    let (y, x) = (dot(w, n), dot(w, u));
+    let y = dot(w, n);
     // On the tet's side, a tiny angle means two near-coplanar faces whose
     // crossing the exact test may see as a miss by rounding (a flat quad
     // cut by both diagonals). For x > 0 and min <= 0.1, |atan2(y, x)| < min
     // iff |y|/x < tan(min), in [min, min (1 + min^2 / 2)]: atan2 (slow)
     // decides only in between.
-    if x < 0.0 {
-        return false;
-    }
     if x > 0.0 && min <= 0.1 {
         let r = y.abs() / x;
         if r < min * (1.0 - 1e-9) {
@@ -336,7 +337,7 @@ fn thin_wedge(f: [u32; 3], fp: [P3; 3], g: [u32; 3], gp: [P3; 3], min: f64) -> b
 struct SeparatingPlanes {
     o: [P3; 4],
     n: [P3; 4],
-    nn: [f64; 4],
+    tol: [f64; 4],
     inv_len: [f64; 4],
 }
 
@@ -345,7 +346,7 @@ impl SeparatingPlanes {
     fn new(tp: &[P3; 4]) -> SeparatingPlanes {
         let mut o = [[0.0; 3]; 4];
         let mut n = [[0.0; 3]; 4];
-        let mut nn = [0.0; 4];
+        let mut tol = [0.0; 4];
         let mut inv_len = [0.0; 4];
         for (i, f) in TET_FACES.iter().enumerate() {
             let (a, b, c) = (tp[f[0]], tp[f[1]], tp[f[2]]);
@@ -353,17 +354,20 @@ impl SeparatingPlanes {
             let v = cross(sub(b, a), sub(c, a));
             o[i] = a;
             n[i] = v;
-            nn[i] = v[0].abs() + v[1].abs() + v[2].abs();
+            // The factor of `separates`' error bound, multiplied first there.
+            tol[i] = 1e-12 * (v[0].abs() + v[1].abs() + v[2].abs());
             inv_len[i] = 1.0 / norm(v).max(1e-300);
         }
-        SeparatingPlanes { o, n, nn, inv_len }
+        SeparatingPlanes { o, n, tol, inv_len }
     }
 
     /// Some face plane has all of `g` more than `margin` outside it: `g`
     /// keeps at least `margin` from the tet.
     #[inline]
     fn clear_of(&self, g: &[P3; 3], margin: f64) -> bool {
-        (0..4).any(|i| {
+        // The base plane first: front faces around the base face lie
+        // mostly under it (any order gives the same answer).
+        [3, 0, 1, 2].into_iter().any(|i| {
             g.iter()
                 .all(|&x| dot(self.n[i], sub(x, self.o[i])) * self.inv_len[i] > margin)
         })
@@ -380,7 +384,8 @@ impl SeparatingPlanes {
     /// strictly outside leaves `g` meeting the tet in shared corners only.
     #[inline]
     fn separates(&self, g: &[P3; 3], gl: [usize; 3]) -> bool {
-        'planes: for i in 0..4 {
+        // The base plane first, as in `clear_of`.
+        'planes: for i in [3, 0, 1, 2] {
             let mut outside = 0;
             for j in 0..3 {
                 if gl[j] < 4 {
@@ -391,7 +396,10 @@ impl SeparatingPlanes {
                 }
                 let d = sub(g[j], self.o[i]);
                 let s = dot(self.n[i], d);
-                let err = 1e-12 * self.nn[i] * (d[0].abs() + d[1].abs() + d[2].abs());
+                if s <= 0.0 {
+                    continue 'planes; // under any error bound
+                }
+                let err = self.tol[i] * (d[0].abs() + d[1].abs() + d[2].abs());
                 if s <= err {
                     continue 'planes;
                 }
@@ -414,18 +422,34 @@ fn heap_entry(key: f64, face: u32) -> Reverse<u64> {
 fn box_dist2(b: &Aabb, p: P3) -> f64 {
     let mut d2 = 0.0;
     for k in 0..3 {
-        let d = (b.min[k] - p[k]).max(p[k] - b.max[k]).max(0.0);
+        // Compare and select, as in `bbox`.
+        let (lo, hi) = (b.min[k] - p[k], p[k] - b.max[k]);
+        let d = if lo > hi { lo } else { hi };
+        let d = if d > 0.0 { d } else { 0.0 };
         d2 += d * d;
     }
     d2
 }
 
-fn tri_box(p: &[P3], v: [u32; 3]) -> Aabb {
-    let mut b = Aabb::EMPTY;
-    for &i in &v {
-        b.grow(p[i as usize]);
+/// The box of `N >= 1` points, by compare and select (`minsd`, where
+/// `f64::min` adds a NaN fix-up): the same box but for the sign of a zero.
+#[inline(always)]
+fn bbox<const N: usize>(p: [P3; N]) -> Aabb {
+    let mut b = Aabb {
+        min: p[0],
+        max: p[0],
+    };
+    for x in &p[1..] {
+        for (k, &c) in x.iter().enumerate() {
+            b.min[k] = if c < b.min[k] { c } else { b.min[k] };
+            b.max[k] = if c > b.max[k] { c } else { b.max[k] };
+        }
     }
     b
+}
+
+fn tri_box(p: &[P3], v: [u32; 3]) -> Aabb {
+    bbox(v.map(|i| p[i as usize]))
 }
 
 /// Fill the region bounded by `input.faces` (paper AF1-AF5).
@@ -581,10 +605,7 @@ impl<'a> Front<'a> {
         self.fgrid.query(q, |g| {
             let w = self.fv[g as usize];
             let p = w.map(|i| self.pts[i as usize]);
-            let mut bb = Aabb::EMPTY;
-            for x in p {
-                bb.grow(x);
-            }
+            let bb = bbox(p);
             if !bb.overlaps(q) {
                 return;
             }
@@ -1032,13 +1053,13 @@ impl<'a> Front<'a> {
             self.pts[v[2] as usize],
             pq,
         ];
-        let mut tb = Aabb::EMPTY;
-        for p in tp {
-            tb.grow(p);
-        }
+        let tb = bbox(tp);
         // The three new faces, built once rather than per near face.
         let nfv: [[u32; 3]; 3] = [0, 1, 2].map(|i| TET_FACES[i].map(|k| tv[k]));
         let nfp: [[P3; 3]; 3] = [0, 1, 2].map(|i| TET_FACES[i].map(|k| tp[k]));
+        // Their boxes: closed triangles with no common corner and apart
+        // boxes cannot meet (exact, the boxes are of the coordinates).
+        let nfb: [Aabb; 3] = nfp.map(bbox);
         let planes = SeparatingPlanes::new(&tp);
         let m_apex = if is_new_point(q) {
             cl.new_point.max(margin)
@@ -1049,14 +1070,7 @@ impl<'a> Front<'a> {
         let tb_clear = tb.inflated(m_apex.max(em));
         // The new edges' boxes, grown by the edge clearance: a front edge
         // whose box misses one is farther than that from the edge.
-        let ebox: [Aabb; 3] = [0, 1, 2].map(|e| {
-            let mut b = Aabb {
-                min: tp[e],
-                max: tp[e],
-            };
-            b.grow(pq);
-            b.inflated(em)
-        });
+        let ebox: [Aabb; 3] = [0, 1, 2].map(|e| bbox([tp[e], pq]).inflated(em));
         for nf in near_f {
             if !nf.bb.overlaps(&tb_clear) {
                 continue;
@@ -1080,23 +1094,17 @@ impl<'a> Front<'a> {
             // crossing a hair apart leave a slab between their faces that
             // only slivers fill (thin plates of CAD needles).
             if em > 0.0 && !planes.clear_of(gp, em) {
-                for e in 0..3 {
-                    if !ebox[e].overlaps(&nf.bb) {
-                        continue;
+                // Front edge k against new edge e = (tv[e], q), by the tet's
+                // local indices: one front edge's box serves all three.
+                for k in 0..3 {
+                    let (l0, l1) = (gl[k], gl[(k + 1) % 3]);
+                    if l0 == 3 || l1 == 3 || (l0 < 4 && l1 < 4) {
+                        continue; // ends at the apex, or an edge of the tet
                     }
-                    let a = tv[e];
-                    for k in 0..3 {
-                        let (g0, g1) = (g[k], g[(k + 1) % 3]);
-                        if g0 == a || g1 == a || g0 == q || g1 == q {
-                            continue;
-                        }
-                        if tv.contains(&g0) && tv.contains(&g1) {
-                            continue; // an edge of the tet itself
-                        }
-                        let (x0, x1) = (gp[k], gp[(k + 1) % 3]);
-                        let mut sb = Aabb { min: x0, max: x0 };
-                        sb.grow(x1);
-                        if !ebox[e].overlaps(&sb) {
+                    let (x0, x1) = (gp[k], gp[(k + 1) % 3]);
+                    let sb = bbox([x0, x1]);
+                    for e in 0..3 {
+                        if l0 == e || l1 == e || !ebox[e].overlaps(&sb) {
                             continue;
                         }
                         if segment_segment_dist2(tp[e], pq, x0, x1) < em * em {
@@ -1105,13 +1113,19 @@ impl<'a> Front<'a> {
                     }
                 }
             }
+            // Corners shared with the tet; new face i has all its corners
+            // but corner i.
+            let nsh = gl.iter().filter(|&&l| l < 4).count();
+            if nsh == 0 && !tb.overlaps(&nf.bb) {
+                continue; // nothing in common with the tet, not even its box
+            }
             let apart = planes.separates(gp, gl);
-            if apart && gl == [4; 3] {
-                continue; // no shared corner: no matching face, no wedge
+            if apart && nsh < 2 {
+                continue; // no common edge: no matching face, no wedge
             }
             for i in 0..3 {
                 let fvid = nfv[i];
-                let shared = fvid.iter().filter(|x| g.contains(x)).count();
+                let shared = nsh - gl.contains(&i) as usize;
                 if shared == 3 {
                     // A matching face must face the other way (AF5).
                     if same_cycle(fvid, g) {
@@ -1122,7 +1136,7 @@ impl<'a> Front<'a> {
                 if shared == 2 && cl.wedge > 0.0 && thin_wedge(fvid, nfp[i], g, *gp, cl.wedge) {
                     return false;
                 }
-                if apart {
+                if apart || (shared == 0 && !nfb[i].overlaps(&nf.bb)) {
                     continue;
                 }
                 let (fp, gq) = shared_first(fvid, nfp[i], g, *gp);
