@@ -28,7 +28,7 @@ pub(crate) const BAD_DEG: f64 = 10.0;
 /// [`BAD_DEG`] (the worst tet is the first criterion).
 pub(crate) const LIFT_DEG: f64 = 0.1;
 /// The min dihedral (degrees) a lift aims at before it minds the count.
-const LIFT_GOAL: f64 = 0.2;
+pub(crate) const LIFT_GOAL: f64 = 0.2;
 /// Cavity kinds ([`Work::cavity`]).
 const CAVITIES: usize = 11;
 /// Largest cavity (tets) considered.
@@ -64,8 +64,8 @@ impl Score {
     /// dihedral up to [`LIFT_GOAL`].
     /// Relative to the cavity's tets before (`old`), so that cavities of
     /// different sizes compare.
-    fn key(&self, old: &Score, lift: bool) -> (f64, isize, f64) {
-        let d = if lift { -self.dmin.min(LIFT_GOAL) } else { 0.0 };
+    fn key(&self, old: &Score, lift: Option<f64>) -> (f64, isize, f64) {
+        let d = lift.map_or(0.0, |g| -self.dmin.min(g));
         (
             d,
             self.under as isize - old.under as isize,
@@ -198,11 +198,12 @@ impl Work<'_> {
 
     /// Evaluates inserting a point around bad tet `t`; on success `c`
     /// holds the replacement (the new point's id is `m.points.len()`) and
-    /// the point's position is returned.
+    /// the point's position is returned. `lift`: the min dihedral to aim
+    /// at first (`None`: the count under [`BAD_DEG`]).
     pub(crate) fn eval_insert(
         &self,
         t: u32,
-        lift: bool,
+        lift: Option<f64>,
         s: &mut InsScratch,
         c: &mut Cand,
     ) -> Result<P3, crate::Outcome> {
@@ -242,7 +243,6 @@ impl Work<'_> {
                 }
             }
         }
-        let lift = lift && min_dihedral_deg(x) < LIFT_DEG;
         let mut best: Option<(Score, Score, P3)> = None;
         for k in 0..CAVITIES {
             if !self.cavity(t, k, s) || !self.star_of(s) {
@@ -278,7 +278,7 @@ impl Work<'_> {
             .fold(f64::INFINITY, f64::min);
         let mut step = 0.3 * len;
         // Lifting the worst tet needs a finer search (they are few).
-        let (iters, stop) = if lift { (60, 1e-4) } else { (20, 1e-2) };
+        let (iters, stop) = if lift.is_some() { (60, 1e-4) } else { (20, 1e-2) };
         for _ in 0..iters {
             if step < stop * len {
                 break;
@@ -302,7 +302,10 @@ impl Work<'_> {
             }
         }
         let ok = (sc.under < old.under && sc.dmin >= old.dmin)
-            || (lift && sc.dmin > old.dmin * (1.0 + MARGIN) + 1e-9);
+            || (lift.is_some()
+                && sc.dmin > old.dmin * (1.0 + MARGIN) + 1e-9
+                // A lift above the bad angle leaves none under it.
+                && lift.is_none_or(|g| g <= BAD_DEG || sc.dmin >= BAD_DEG));
         if !ok {
             return Err(Outcome::NotBetter);
         }
@@ -445,6 +448,109 @@ impl Work<'_> {
                 continue;
             }
             best = Some((gain, under, dmin));
+            c.new.clear();
+            let mut stack = vec![(0usize, n - 1)];
+            while let Some((i, j)) = stack.pop() {
+                if j - i < 2 {
+                    continue;
+                }
+                let k = dp[i][j].1;
+                let (ri, rk, rj) = (s.ring[i], s.ring[k], s.ring[j]);
+                c.new.push([ri, rk, rj, b]);
+                c.new.push([ri, rj, rk, a]);
+                stack.push((i, k));
+                stack.push((k, j));
+            }
+            c.old.clear();
+            c.old.extend_from_slice(&s.tets);
+            found = Outcome::Done;
+        }
+        found
+    }
+}
+
+impl Work<'_> {
+    /// Swaps that lift the min dihedral (§9.1's 2-3 and edge removal):
+    /// the best of tet `t`'s 4 face swaps and 6 edge removals by the
+    /// cavity's min dihedral, kept when it is higher than before and at
+    /// least [`BAD_DEG`] (the count passes see to the tets under it). Edge
+    /// removal takes the ring's max-min triangulation (Klincsek's
+    /// programme on the min). Where every point is on the surface (a plate
+    /// one size thick) swaps are all that can raise it.
+    pub(crate) fn eval_lift_swap(
+        &self,
+        t: u32,
+        s: &mut InsScratch,
+        c: &mut Cand,
+    ) -> crate::Outcome {
+        use crate::Outcome;
+        let v = self.m.tets[t as usize];
+        let d_of = |x: [P3; 4]| positive(x).then(|| min_dihedral_deg(x));
+        let mut best = f64::NEG_INFINITY;
+        let mut found = Outcome::NotBetter;
+        for f in 0..4 {
+            let Some(n) = self.free_neighbour(t, f) else {
+                continue;
+            };
+            let nt = n.tet().0;
+            let e = self.m.tets[nt as usize][n.local()];
+            let d = v[f];
+            let [a, b, cc] = TET_FACES[f].map(|l| v[l]);
+            let new = [[d, e, a, b], [d, e, b, cc], [d, e, cc, a]];
+            let old = self.score_old(&[t, nt]).dmin;
+            let dmin = new
+                .iter()
+                .map(|&nv| d_of(self.pts(nv)).unwrap_or(f64::NEG_INFINITY))
+                .fold(f64::INFINITY, f64::min);
+            if dmin > old && dmin >= BAD_DEG && dmin > best {
+                best = dmin;
+                c.old.clear();
+                c.old.extend([t, nt]);
+                c.new.clear();
+                c.new.extend(new);
+                found = Outcome::Done;
+            }
+        }
+        for e in TET_EDGES {
+            let (a, b) = (v[e[0]], v[e[1]]);
+            if self.ring(t, a, b, &mut s.tets, &mut s.ring).is_none() {
+                continue;
+            }
+            let old = self.score_old(&s.tets).dmin;
+            let n = s.ring.len();
+            let (pa, pb) = (self.m.points[a.idx()], self.m.points[b.idx()]);
+            let r: Vec<P3> = s.ring.iter().map(|p| self.m.points[p.idx()]).collect();
+            // dp[i][j]: (min dihedral, k) of the best triangulation of the
+            // ring polygon i..j.
+            const N: usize = crate::work::MAX_RING;
+            let mut dp = [[(f64::INFINITY, 0usize); N]; N];
+            for len in 2..n {
+                for i in 0..n - len {
+                    let j = i + len;
+                    let mut bk = (f64::NEG_INFINITY, 0);
+                    for k in i + 1..j {
+                        let m = dp[i][k].0.min(dp[k][j].0);
+                        if m <= bk.0 {
+                            continue;
+                        }
+                        let (Some(t1), Some(t2)) =
+                            (d_of([r[i], r[k], r[j], pb]), d_of([r[i], r[j], r[k], pa]))
+                        else {
+                            continue;
+                        };
+                        let m = m.min(t1).min(t2);
+                        if m > bk.0 {
+                            bk = (m, k);
+                        }
+                    }
+                    dp[i][j] = bk;
+                }
+            }
+            let dmin = dp[0][n - 1].0;
+            if !(dmin > old && dmin >= BAD_DEG && dmin > best) {
+                continue;
+            }
+            best = dmin;
             c.new.clear();
             let mut stack = vec![(0usize, n - 1)];
             while let Some((i, j)) = stack.pop() {

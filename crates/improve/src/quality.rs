@@ -26,6 +26,7 @@ pub fn quality(p: [P3; 4]) -> f64 {
 /// measure). Only the last polish uses it, on the few tets whose worst
 /// dihedral is far below what their mean ratio says (caps on a surface
 /// triangle with an angle near 180°).
+#[inline]
 pub fn min_dihedral_deg(p: [P3; 4]) -> f64 {
     use parafront_geom::{cross, dot, norm, sub};
     const E: [[usize; 4]; 6] = [
@@ -49,6 +50,7 @@ pub fn min_dihedral_deg(p: [P3; 4]) -> f64 {
 /// Whether a dihedral angle of the tet is under `tan_max` in tangent
 /// (and acute): `min_dihedral_deg(p) < deg` with `tan_max = tan(deg)`,
 /// without the arc tangents. At edge `e`, `|n1 x n2| = |e| |6V|`.
+#[inline]
 pub fn has_dihedral_under(p: [P3; 4], tan_max: f64) -> bool {
     use parafront_geom::{cross, dot, norm, sub};
     let v6 = tet_volume6(p[0], p[1], p[2], p[3]).abs();

@@ -366,3 +366,32 @@ fn swap_for_the_dihedral_angles() {
     assert_eq!(under_10(&m), 0);
     assert!(min_dihedral(&m) > d0);
 }
+
+#[test]
+fn swap_that_lifts_the_min_dihedral() {
+    // Two tets on a wide triangle at about 17°, none under 10°: the count
+    // swap has nothing to do, the lift swap makes the three tets around
+    // the apexes' edge, whose min dihedral is higher; then nothing lifts.
+    let s = 3f64.sqrt() / 2.0;
+    let pts = vec![
+        [1.0, 0.0, 0.0],
+        [-0.5, s, 0.0],
+        [-0.5, -s, 0.0],
+        [0.0, 0.0, -0.15],
+        [0.0, 0.0, 0.15],
+    ];
+    let mut m = mesh(pts, &[[0, 1, 2, 4], [0, 2, 1, 3]]);
+    let (tr, vol, d0) = (tris(&m), m.volume(), min_dihedral(&m));
+    assert_eq!(under_10(&m), 0);
+    assert!(d0 < 18.0, "{d0}");
+    let mut imp = Improver::new(&mut m, &[]).unwrap();
+    assert_eq!(imp.swap_for_dihedral(0), Outcome::NotBetter);
+    assert_eq!(imp.swap_for_min_dihedral(0), Outcome::Done);
+    assert_eq!(imp.swap_for_min_dihedral(0), Outcome::NotBetter);
+    assert_eq!(imp.swap_for_min_dihedral(99), Outcome::NotFound);
+    imp.finish();
+    m.check().unwrap();
+    assert_eq!(m.tets.len(), 3);
+    assert_same_domain(&m, &tr, vol);
+    assert!(min_dihedral(&m) > d0 + 1.0, "{} against {d0}", min_dihedral(&m));
+}

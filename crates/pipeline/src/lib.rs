@@ -66,6 +66,10 @@ pub struct MeshOptions {
     /// more passes. See `parafront_improve::ImproveOptions`.
     #[serde(default = "default_optimize")]
     pub optimize: u8,
+    /// Parts improved in parallel (§9.5): 0 (default) one per 100k tets,
+    /// 1 serial. See `parafront_improve::ImproveOptions::parts`.
+    #[serde(default)]
+    pub optimize_parts: usize,
 }
 
 fn default_optimize() -> u8 {
@@ -85,6 +89,7 @@ impl Default for MeshOptions {
             debug_partial: false,
             progress: None,
             optimize: default_optimize(),
+            optimize_parts: 0,
             regions: false,
         }
     }
@@ -220,7 +225,7 @@ pub fn mesh_surface(s: &Surface, opts: &MeshOptions) -> Result<(TetMesh, Summary
         let frozen = vec![true; s.points.len()];
         let io = parafront_improve::ImproveOptions {
             level: opts.optimize,
-            ..Default::default()
+            parts: opts.optimize_parts,
         };
         let st = parafront_improve::improve(&mut mesh, &frozen, &io)
             .map_err(|e| MeshError::Topology(e.to_string()))?;
