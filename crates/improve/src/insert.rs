@@ -332,6 +332,31 @@ impl Work<'_> {
     }
 }
 
+/// The tets of a ring triangulation around edge `a b` (`split(i, j)`: the
+/// ring point that splits polygon `i..j`), into `out`.
+fn ring_tets(
+    ring: &[PointId],
+    n: usize,
+    split: impl Fn(usize, usize) -> usize,
+    a: PointId,
+    b: PointId,
+    out: &mut Vec<[PointId; 4]>,
+) {
+    out.clear();
+    let mut stack = vec![(0usize, n - 1)];
+    while let Some((i, j)) = stack.pop() {
+        if j - i < 2 {
+            continue;
+        }
+        let k = split(i, j);
+        let (ri, rk, rj) = (ring[i], ring[k], ring[j]);
+        out.push([ri, rk, rj, b]);
+        out.push([ri, rj, rk, a]);
+        stack.push((i, k));
+        stack.push((k, j));
+    }
+}
+
 /// Cost of a new tet for the count swaps: 1000 if under [`BAD_DEG`],
 /// plus its shortfall below 12°; `None` when not positive. Also its min
 /// dihedral.
@@ -448,19 +473,7 @@ impl Work<'_> {
                 continue;
             }
             best = Some((gain, under, dmin));
-            c.new.clear();
-            let mut stack = vec![(0usize, n - 1)];
-            while let Some((i, j)) = stack.pop() {
-                if j - i < 2 {
-                    continue;
-                }
-                let k = dp[i][j].1;
-                let (ri, rk, rj) = (s.ring[i], s.ring[k], s.ring[j]);
-                c.new.push([ri, rk, rj, b]);
-                c.new.push([ri, rj, rk, a]);
-                stack.push((i, k));
-                stack.push((k, j));
-            }
+            ring_tets(&s.ring, n, |i, j| dp[i][j].1, a, b, &mut c.new);
             c.old.clear();
             c.old.extend_from_slice(&s.tets);
             found = Outcome::Done;
@@ -551,19 +564,7 @@ impl Work<'_> {
                 continue;
             }
             best = dmin;
-            c.new.clear();
-            let mut stack = vec![(0usize, n - 1)];
-            while let Some((i, j)) = stack.pop() {
-                if j - i < 2 {
-                    continue;
-                }
-                let k = dp[i][j].1;
-                let (ri, rk, rj) = (s.ring[i], s.ring[k], s.ring[j]);
-                c.new.push([ri, rk, rj, b]);
-                c.new.push([ri, rj, rk, a]);
-                stack.push((i, k));
-                stack.push((k, j));
-            }
+            ring_tets(&s.ring, n, |i, j| dp[i][j].1, a, b, &mut c.new);
             c.old.clear();
             c.old.extend_from_slice(&s.tets);
             found = Outcome::Done;
