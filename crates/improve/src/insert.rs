@@ -15,7 +15,7 @@
 //! a tet under [`LIFT_DEG`], when the cavity's min dihedral rises.
 use crate::ops::{positive, Cand, MARGIN};
 use crate::quality::{min_dihedral_deg, quality};
-use crate::work::Work;
+use crate::work::{ring_tets, Work};
 use parafront_geom::{cross, dist2, norm, sub, P3};
 use parafront_mesh::quality::TET_EDGES;
 use parafront_mesh::{PointId, TET_FACES};
@@ -59,6 +59,22 @@ struct Score {
 }
 
 impl Score {
+    /// Of no tet: the start of a sum.
+    const NONE: Score = Score {
+        under: 0,
+        short: 0.0,
+        dmin: f64::INFINITY,
+        qmin: f64::INFINITY,
+    };
+
+    /// Adds a tet of min dihedral `d` and mean ratio `q`.
+    fn add(&mut self, d: f64, q: f64) {
+        self.under += usize::from(d < BAD_DEG);
+        self.short += (12.0 - d).max(0.0);
+        self.dmin = self.dmin.min(d);
+        self.qmin = self.qmin.min(q);
+    }
+
     /// What the search minimises: the count under [`BAD_DEG`] then the
     /// shortfall; with `lift` (a tet under [`LIFT_DEG`]) first the min
     /// dihedral up to [`LIFT_GOAL`].
@@ -117,23 +133,14 @@ impl Work<'_> {
     }
 
     fn score_star(&self, star: &[([PointId; 4], usize)], pos: P3) -> Option<Score> {
-        let mut sc = Score {
-            under: 0,
-            short: 0.0,
-            dmin: f64::INFINITY,
-            qmin: f64::INFINITY,
-        };
+        let mut sc = Score::NONE;
         for &(v, f) in star {
             let mut x = self.pts(v);
             x[f] = pos;
             if !positive(x) {
                 return None;
             }
-            let d = min_dihedral_deg(x);
-            sc.under += usize::from(d < BAD_DEG);
-            sc.short += (12.0 - d).max(0.0);
-            sc.dmin = sc.dmin.min(d);
-            sc.qmin = sc.qmin.min(quality(x));
+            sc.add(min_dihedral_deg(x), quality(x));
         }
         Some(sc)
     }
@@ -180,18 +187,12 @@ impl Work<'_> {
 
     /// Old cavity's score from the stored tets.
     fn score_old(&self, cav: &[u32]) -> Score {
-        let mut sc = Score {
-            under: 0,
-            short: 0.0,
-            dmin: f64::INFINITY,
-            qmin: f64::INFINITY,
-        };
+        let mut sc = Score::NONE;
         for &t in cav {
-            let d = min_dihedral_deg(self.pts(self.m.tets[t as usize]));
-            sc.under += usize::from(d < BAD_DEG);
-            sc.short += (12.0 - d).max(0.0);
-            sc.dmin = sc.dmin.min(d);
-            sc.qmin = sc.qmin.min(self.q[t as usize]);
+            sc.add(
+                min_dihedral_deg(self.pts(self.m.tets[t as usize])),
+                self.q[t as usize],
+            );
         }
         sc
     }
@@ -278,7 +279,11 @@ impl Work<'_> {
             .fold(f64::INFINITY, f64::min);
         let mut step = 0.3 * len;
         // Lifting the worst tet needs a finer search (they are few).
-        let (iters, stop) = if lift.is_some() { (60, 1e-4) } else { (20, 1e-2) };
+        let (iters, stop) = if lift.is_some() {
+            (60, 1e-4)
+        } else {
+            (20, 1e-2)
+        };
         for _ in 0..iters {
             if step < stop * len {
                 break;
@@ -332,31 +337,6 @@ impl Work<'_> {
     }
 }
 
-/// The tets of a ring triangulation around edge `a b` (`split(i, j)`: the
-/// ring point that splits polygon `i..j`), into `out`.
-fn ring_tets(
-    ring: &[PointId],
-    n: usize,
-    split: impl Fn(usize, usize) -> usize,
-    a: PointId,
-    b: PointId,
-    out: &mut Vec<[PointId; 4]>,
-) {
-    out.clear();
-    let mut stack = vec![(0usize, n - 1)];
-    while let Some((i, j)) = stack.pop() {
-        if j - i < 2 {
-            continue;
-        }
-        let k = split(i, j);
-        let (ri, rk, rj) = (ring[i], ring[k], ring[j]);
-        out.push([ri, rk, rj, b]);
-        out.push([ri, rj, rk, a]);
-        stack.push((i, k));
-        stack.push((k, j));
-    }
-}
-
 /// Cost of a new tet for the count swaps: 1000 if under [`BAD_DEG`],
 /// plus its shortfall below 12°; `None` when not positive. Also its min
 /// dihedral.
@@ -387,14 +367,9 @@ impl Work<'_> {
         let mut best: Option<(f64, usize, f64)> = None;
         let mut found = Outcome::NotBetter;
         for f in 0..4 {
-            let Some(n) = self.free_neighbour(t, f) else {
+            let Some((nt, new)) = self.face_swap(t, f) else {
                 continue;
             };
-            let nt = n.tet().0;
-            let e = self.m.tets[nt as usize][n.local()];
-            let d = v[f];
-            let [a, b, cc] = TET_FACES[f].map(|l| v[l]);
-            let new = [[d, e, a, b], [d, e, b, cc], [d, e, cc, a]];
             s.cav.clear();
             s.cav.extend([t, nt]);
             let old = self.score_old(&s.cav);
@@ -473,7 +448,8 @@ impl Work<'_> {
                 continue;
             }
             best = Some((gain, under, dmin));
-            ring_tets(&s.ring, n, |i, j| dp[i][j].1, a, b, &mut c.new);
+            c.new.clear();
+            ring_tets(&s.ring, (0, n - 1), &|i, j| dp[i][j].1, a, b, &mut c.new);
             c.old.clear();
             c.old.extend_from_slice(&s.tets);
             found = Outcome::Done;
@@ -502,14 +478,9 @@ impl Work<'_> {
         let mut best = f64::NEG_INFINITY;
         let mut found = Outcome::NotBetter;
         for f in 0..4 {
-            let Some(n) = self.free_neighbour(t, f) else {
+            let Some((nt, new)) = self.face_swap(t, f) else {
                 continue;
             };
-            let nt = n.tet().0;
-            let e = self.m.tets[nt as usize][n.local()];
-            let d = v[f];
-            let [a, b, cc] = TET_FACES[f].map(|l| v[l]);
-            let new = [[d, e, a, b], [d, e, b, cc], [d, e, cc, a]];
             let old = self.score_old(&[t, nt]).dmin;
             let dmin = new
                 .iter()
@@ -564,7 +535,8 @@ impl Work<'_> {
                 continue;
             }
             best = dmin;
-            ring_tets(&s.ring, n, |i, j| dp[i][j].1, a, b, &mut c.new);
+            c.new.clear();
+            ring_tets(&s.ring, (0, n - 1), &|i, j| dp[i][j].1, a, b, &mut c.new);
             c.old.clear();
             c.old.extend_from_slice(&s.tets);
             found = Outcome::Done;

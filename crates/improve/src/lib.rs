@@ -152,9 +152,7 @@ pub fn improve(
         imp.selective_pass(POLISH, &mut st);
         imp.swap_pass(POLISH, &mut st);
         imp.dihedral_pass(&mut st);
-        imp.dihedral_count_passes(&mut st);
-        imp.dihedral_pass(&mut st);
-        imp.lift_worst_pass(&mut st);
+        imp.whole_mesh_passes(&mut st);
         st.points_removed += imp.w.compact(true).iter().filter(|&&d| d).count();
     }
     st.tets_after = mesh.tets.len();
@@ -236,9 +234,7 @@ pub(crate) fn run(
         // what follows never lowers the min dihedral, so the result keeps
         // at least the min of the passes before.
         if whole {
-            imp.dihedral_count_passes(st);
-            imp.dihedral_pass(st);
-            imp.lift_worst_pass(st);
+            imp.whole_mesh_passes(st);
         }
     }
     Ok(imp.w.compact(drop_points))
@@ -398,6 +394,21 @@ impl<'m> Improver<'m> {
         self.finish_op(o)
     }
 
+    /// What follows the last dihedral polish on a whole mesh (parts leave
+    /// it to the final polish): the passes for the tets under 10°, the
+    /// polish again, and the lift of the worst.
+    fn whole_mesh_passes(&mut self, st: &mut ImproveStats) {
+        self.dihedral_count_passes(st);
+        self.dihedral_pass(st);
+        self.lift_worst_pass(st);
+    }
+
+    /// Whether tet `t` is alive with min dihedral still `d0` (what a
+    /// worst-first list saw before the operations on it).
+    fn unchanged(&self, t: u32, d0: f64) -> bool {
+        self.w.alive(t) && quality::min_dihedral_deg(self.w.pts(self.w.m.tets[t as usize])) == d0
+    }
+
     /// The worst tets under [`LIFT_SWAP_DEG`] ([`LIFT_WORST`] of them),
     /// worst first, each lifted by a swap or else a point, when that
     /// raises its cavity's min dihedral to at least 10°: the mesh's min
@@ -408,30 +419,34 @@ impl<'m> Improver<'m> {
         let mut worst: Vec<(f64, u32)> = (0..self.w.m.tets.len() as u32)
             .filter(|&t| {
                 self.w.alive(t)
-                    && quality::has_dihedral_under(
-                        self.w.pts(self.w.m.tets[t as usize]),
-                        TAN_LIFT,
-                    )
+                    && quality::has_dihedral_under(self.w.pts(self.w.m.tets[t as usize]), TAN_LIFT)
             })
-            .map(|t| (quality::min_dihedral_deg(self.w.pts(self.w.m.tets[t as usize])), t))
+            .map(|t| {
+                (
+                    quality::min_dihedral_deg(self.w.pts(self.w.m.tets[t as usize])),
+                    t,
+                )
+            })
             .filter(|x| x.0 < LIFT_SWAP_DEG)
             .collect();
         worst.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
         worst.truncate(LIFT_WORST);
         for (d0, t) in worst {
-            if !self.w.alive(t)
-                || quality::min_dihedral_deg(self.w.pts(self.w.m.tets[t as usize])) != d0
-            {
+            if !self.unchanged(t, d0) {
+                continue;
+            }
+            st.swap.tried += 1;
+            if self.swap_for_min_dihedral(t) == Outcome::Done {
+                st.swap.done += 1;
                 continue;
             }
             st.insert.tried += 1;
-            if self.swap_for_min_dihedral(t) == Outcome::Done {
-                st.swap.done += 1;
-            } else if self.insert_with(t, Some(LIFT_SWAP_DEG)) == Outcome::Done {
+            if self.insert_with(t, Some(LIFT_SWAP_DEG)) == Outcome::Done {
                 st.insert.done += 1;
                 st.points_inserted += 1;
             }
         }
+        // Counted with the insertion.
         st.insert.seconds += t0.elapsed().as_secs_f64();
     }
 
@@ -456,10 +471,7 @@ impl<'m> Improver<'m> {
             }
             let mut changed = 0;
             for (d0, t) in bad {
-                if !self.w.alive(t)
-                    || (!lift && self.w.tested[t as usize])
-                    || quality::min_dihedral_deg(self.w.pts(self.w.m.tets[t as usize])) != d0
-                {
+                if !self.unchanged(t, d0) || (!lift && self.w.tested[t as usize]) {
                     continue;
                 }
                 st.insert.tried += 1;
@@ -508,9 +520,7 @@ impl<'m> Improver<'m> {
             let bad = self.under_deg(insert::BAD_DEG);
             let mut changed = 0;
             for (d0, t) in bad {
-                if !self.w.alive(t)
-                    || quality::min_dihedral_deg(self.w.pts(self.w.m.tets[t as usize])) != d0
-                {
+                if !self.unchanged(t, d0) {
                     continue;
                 }
                 st.swap.tried += 1;

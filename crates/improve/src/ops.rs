@@ -7,7 +7,7 @@
 //! beats the worst of those it replaces, and every new tet is positive
 //! under the exact predicate and in floating point.
 use crate::quality::{min_dihedral_deg, quality};
-use crate::work::{Work, MAX_RING};
+use crate::work::{ring_tets, Work, MAX_RING};
 use parafront_geom::{cross, dist2, norm, orient3d, sub, tet_volume6, P3};
 use parafront_mesh::{PointId, TET_FACES};
 
@@ -91,7 +91,6 @@ pub(crate) struct Scratch {
     pub nb2: Vec<PointId>,
     tq: Vec<f64>,
     dp: Vec<(f64, u8)>,
-    stack: Vec<(u8, u8)>,
 }
 
 impl Work<'_> {
@@ -102,16 +101,10 @@ impl Work<'_> {
     /// §9.1 face swap 2-3: face `f` of `t` and the tet behind it become
     /// three tets around the edge joining their apexes.
     pub(crate) fn eval_23(&self, t: u32, f: usize, c: &mut Cand) -> Outcome {
-        let Some(n) = self.free_neighbour(t, f) else {
+        let Some((nt, new)) = self.face_swap(t, f) else {
             return Outcome::Constrained;
         };
-        let v = self.m.tets[t as usize];
-        let d = v[f];
-        let [a, b, cc] = TET_FACES[f].map(|l| v[l]);
-        let nt = n.tet().0;
-        let e = self.m.tets[nt as usize][n.local()];
         let qold = self.q[t as usize].min(self.q[nt as usize]);
-        let new = [[d, e, a, b], [d, e, b, cc], [d, e, cc, a]];
         let mut qmin = f64::INFINITY;
         for &nv in &new {
             qmin = qmin.min(quality(self.pts(nv)));
@@ -191,20 +184,15 @@ impl Work<'_> {
             return Outcome::NotBetter;
         }
         c.new.clear();
-        s.stack.clear();
-        s.stack.push((0, (n - 1) as u8));
-        while let Some((i, j)) = s.stack.pop() {
-            let (i, j) = (i as usize, j as usize);
-            if j - i < 2 {
-                continue;
-            }
-            let k = s.dp[i * N + j].1 as usize;
-            let (ri, rk, rj) = (s.ring[i], s.ring[k], s.ring[j]);
-            c.new.push([ri, rk, rj, b]);
-            c.new.push([ri, rj, rk, a]);
-            s.stack.push((i as u8, k as u8));
-            s.stack.push((k as u8, j as u8));
-        }
+        let dp = &s.dp;
+        ring_tets(
+            &s.ring,
+            (0, n - 1),
+            &|i, j| dp[i * N + j].1 as usize,
+            a,
+            b,
+            &mut c.new,
+        );
         if !self.all_positive(&c.new) {
             return Outcome::Inverted;
         }

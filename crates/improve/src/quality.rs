@@ -22,23 +22,23 @@ pub fn quality(p: [P3; 4]) -> f64 {
     }
 }
 
+/// Each edge of a tet (its first two corners) with the two other corners.
+const EDGE_SIDES: [[usize; 4]; 6] = [
+    [0, 1, 2, 3],
+    [0, 2, 1, 3],
+    [0, 3, 1, 2],
+    [1, 2, 0, 3],
+    [1, 3, 0, 2],
+    [2, 3, 0, 1],
+];
+
 /// The smallest dihedral angle of a tet, in degrees (the other
-/// measure). Only the last polish uses it, on the few tets whose worst
-/// dihedral is far below what their mean ratio says (caps on a surface
-/// triangle with an angle near 180°).
-#[inline]
+/// measure): the last polish, and the passes for the tets under 10° and
+/// for the worst ones, which work on the angles themselves.
 pub fn min_dihedral_deg(p: [P3; 4]) -> f64 {
     use parafront_geom::{cross, dot, norm, sub};
-    const E: [[usize; 4]; 6] = [
-        [0, 1, 2, 3],
-        [0, 2, 1, 3],
-        [0, 3, 1, 2],
-        [1, 2, 0, 3],
-        [1, 3, 0, 2],
-        [2, 3, 0, 1],
-    ];
     let mut m = f64::INFINITY;
-    for [a, b, c, d] in E {
+    for [a, b, c, d] in EDGE_SIDES {
         let e = sub(p[b], p[a]);
         let n1 = cross(e, sub(p[c], p[a]));
         let n2 = cross(e, sub(p[d], p[a]));
@@ -50,19 +50,10 @@ pub fn min_dihedral_deg(p: [P3; 4]) -> f64 {
 /// Whether a dihedral angle of the tet is under `tan_max` in tangent
 /// (and acute): `min_dihedral_deg(p) < deg` with `tan_max = tan(deg)`,
 /// without the arc tangents. At edge `e`, `|n1 x n2| = |e| |6V|`.
-#[inline]
 pub fn has_dihedral_under(p: [P3; 4], tan_max: f64) -> bool {
     use parafront_geom::{cross, dot, norm, sub};
     let v6 = tet_volume6(p[0], p[1], p[2], p[3]).abs();
-    const E: [[usize; 4]; 6] = [
-        [0, 1, 2, 3],
-        [0, 2, 1, 3],
-        [0, 3, 1, 2],
-        [1, 2, 0, 3],
-        [1, 3, 0, 2],
-        [2, 3, 0, 1],
-    ];
-    E.iter().any(|&[a, b, c, d]| {
+    EDGE_SIDES.iter().any(|&[a, b, c, d]| {
         let e = sub(p[b], p[a]);
         let c12 = dot(cross(e, sub(p[c], p[a])), cross(e, sub(p[d], p[a])));
         c12 > 0.0 && norm(e) * v6 < tan_max * c12

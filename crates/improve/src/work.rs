@@ -12,6 +12,29 @@ pub(crate) const DEAD: [PointId; 4] = [PointId(u32::MAX); 4];
 /// Most tets around an edge that edge removal considers.
 pub(crate) const MAX_RING: usize = 10;
 
+/// Appends the tets of a triangulation of `ring` (a polygon around edge
+/// `a b`) to `out`: `split(i, j)` is the ring point that splits polygon
+/// `i..=j`, as the edge removals' dynamic programmes leave it. Order: a
+/// polygon's two tets, then its right part, then its left.
+pub(crate) fn ring_tets(
+    ring: &[PointId],
+    (i, j): (usize, usize),
+    split: &impl Fn(usize, usize) -> usize,
+    a: PointId,
+    b: PointId,
+    out: &mut Vec<[PointId; 4]>,
+) {
+    if j - i < 2 {
+        return;
+    }
+    let k = split(i, j);
+    let (ri, rk, rj) = (ring[i], ring[k], ring[j]);
+    out.push([ri, rk, rj, b]);
+    out.push([ri, rj, rk, a]);
+    ring_tets(ring, (k, j), split, a, b, out);
+    ring_tets(ring, (i, k), split, a, b, out);
+}
+
 pub(crate) struct Work<'m> {
     pub m: &'m mut TetMesh,
     /// Points that never move or disappear: the caller's frozen points plus
@@ -121,6 +144,19 @@ impl<'m> Work<'m> {
     pub fn free_neighbour(&self, t: u32, f: usize) -> Option<FaceRef> {
         let n = self.m.neigh[4 * t as usize + f];
         (!n.is_none() && self.m.region[n.tet().idx()] == self.m.region[t as usize]).then_some(n)
+    }
+
+    /// The 2-3 swap across face `f` of `t` (§9.1), when that face is free:
+    /// the tet behind it, and the three tets around the edge joining the
+    /// two apexes.
+    pub(crate) fn face_swap(&self, t: u32, f: usize) -> Option<(u32, [[PointId; 4]; 3])> {
+        let n = self.free_neighbour(t, f)?;
+        let v = self.m.tets[t as usize];
+        let d = v[f];
+        let [a, b, c] = TET_FACES[f].map(|l| v[l]);
+        let nt = n.tet().0;
+        let e = self.m.tets[nt as usize][n.local()];
+        Some((nt, [[d, e, a, b], [d, e, b, c], [d, e, c, a]]))
     }
 
     /// The tets containing `p`, by a walk over faces through `p` (a point

@@ -393,5 +393,9 @@ fn swap_that_lifts_the_min_dihedral() {
     m.check().unwrap();
     assert_eq!(m.tets.len(), 3);
     assert_same_domain(&m, &tr, vol);
-    assert!(min_dihedral(&m) > d0 + 1.0, "{} against {d0}", min_dihedral(&m));
+    assert!(
+        min_dihedral(&m) > d0 + 1.0,
+        "{} against {d0}",
+        min_dihedral(&m)
+    );
 }

@@ -1116,7 +1116,7 @@ const PASS4_ROUNDS: [u32; 5] = [1, 12, 12, 12, 60];
 /// serial front still gets stuck) and send their faces along.
 /// `rounds`: the recovery rounds of each try. Returns the tets made and
 /// the tets removed.
-pub(crate) fn serial_pass<C: Comm>(
+fn serial_pass<C: Comm>(
     parts: &mut [Part],
     comm: &C,
     size: &(dyn Fn(P3) -> f64 + Sync),

@@ -144,9 +144,7 @@ fn parallel_parts_are_valid_and_independent_of_threads() {
     );
     assert!(q.radius_ratio.mean >= qs.radius_ratio.mean - 0.005);
     // Issue 5: serial and parallel improvement within 0.5 points.
-    assert!(
-        (100.0 * (q.share_min_dihedral_below - qs.share_min_dihedral_below)).abs() <= 0.5
-    );
+    assert!((100.0 * (q.share_min_dihedral_below - qs.share_min_dihedral_below)).abs() <= 0.5);
 }
 
 #[test]
