@@ -26,6 +26,9 @@ const MAX_LEVELS: usize = 40;
 struct Entry {
     key: [f32; 8],
     id: u32,
+    /// The item's payload (a face's corners): a hit then needs no load
+    /// from the caller's arrays, which are ten times the live front.
+    v: [u32; 3],
 }
 
 #[inline]
@@ -152,9 +155,9 @@ impl LooseGrid {
         )
     }
 
-    /// Insert item `id` with box `b` (the same box must be given to
+    /// Insert item `id`, carrying `v`, with box `b` (the same box must be given to
     /// `remove`).
-    pub fn insert(&mut self, id: u32, b: &Aabb) {
+    pub fn insert(&mut self, id: u32, v: [u32; 3], b: &Aabb) {
         let (k, key) = self.place(b);
         let (lo, hi) = self.rel(b);
         let lv = &mut self.levels[k];
@@ -173,7 +176,7 @@ impl LooseGrid {
             }
         };
         let key = lanes(lo, hi, f32::NEG_INFINITY);
-        self.cells[c as usize].push(Entry { key, id });
+        self.cells[c as usize].push(Entry { key, id, v });
         lv.len += 1;
         self.used |= 1 << k;
         self.len += 1;
@@ -202,14 +205,14 @@ impl LooseGrid {
         self.len -= 1;
     }
 
-    /// Calls `f(id)` for every item whose box may overlap `q` (a superset:
+    /// Calls `f(id, v)` for every item whose box may overlap `q` (a superset:
     /// the boxes are `f32`, rounded outwards).
-    pub fn query(&self, q: &Aabb, mut f: impl FnMut(u32)) {
+    pub fn query(&self, q: &Aabb, mut f: impl FnMut(u32, [u32; 3])) {
         let (qlo, qhi) = self.rel(q);
         let qk = lanes(qhi, qlo, f32::INFINITY);
         let mut scan = |cell: &[Entry]| {
             // Branch-free: a branch per entry was often mispredicted.
-            let mut buf = [0u32; 64];
+            let mut buf = [(0u32, [0u32; 3]); 64];
             for chunk in cell.chunks(64) {
                 let mut n = 0;
                 for e in chunk {
@@ -217,11 +220,11 @@ impl LooseGrid {
                     for (a, b) in e.key.iter().zip(&qk) {
                         hit &= a <= b;
                     }
-                    buf[n & 63] = e.id;
+                    buf[n & 63] = (e.id, e.v);
                     n += hit as usize;
                 }
-                for &id in &buf[..n] {
-                    f(id);
+                for &(id, v) in &buf[..n] {
+                    f(id, v);
                 }
             }
         };
@@ -305,7 +308,7 @@ mod tests {
         for id in 0..3000u32 {
             let c = [rnd(), rnd(), rnd()];
             let e = 0.001 * (1.0 + 300.0 * rnd() * rnd() * rnd());
-            g.insert(id, &Aabb { min: c, max: c }.inflated(0.5 * e));
+            g.insert(id, [id; 3], &Aabb { min: c, max: c }.inflated(0.5 * e));
             items.push((id, c, e));
         }
         // Remove a third, then check queries.
@@ -320,7 +323,10 @@ mod tests {
             let r = 0.2 * rnd();
             let q = Aabb { min: c, max: c }.inflated(r);
             let mut got = Vec::new();
-            g.query(&q, |id| got.push(id));
+            g.query(&q, |id, v| {
+                assert_eq!(v, [id; 3]);
+                got.push(id)
+            });
             got.sort();
             got.dedup();
             for id in brute(&items, &q) {

@@ -12,6 +12,7 @@
 mod core;
 pub mod grid;
 mod quality;
+mod queue;
 
 pub use crate::core::{
     advance, FrontError, FrontInput, FrontOptions, FrontResult, FrontStats, Partial,

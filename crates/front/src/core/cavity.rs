@@ -90,7 +90,7 @@ impl<'a> Front<'a> {
             i += 1;
             let v = self.fv[f as usize];
             let bb = tri_box(&self.pts, v);
-            self.fgrid.query(&bb, |g| {
+            self.fgrid.query(&bb, |g, _| {
                 if seen.contains_key(&g) || !self.falive[g as usize] {
                     return;
                 }

@@ -4,13 +4,12 @@
 //! that gets stuck.
 use crate::grid::LooseGrid;
 use crate::quality::candidate_score;
+use crate::queue::MinQueue;
 use crate::{RegionFilter, SizeMode};
 use parafront_geom::intersect::triangles_intersect;
 use parafront_geom::*;
 use parafront_mesh::TET_FACES;
 use rustc_hash::FxHashMap;
-use std::cmp::Reverse;
-use std::collections::BinaryHeap;
 
 mod cavity;
 
@@ -167,7 +166,7 @@ struct Front<'a> {
     fmap: FxHashMap<[u32; 3], u32>,
     /// AF1's queue: `key << 32 | face`, the key an `f32` size (positive
     /// floats order as their bits), so one entry is 8 bytes.
-    heap: BinaryHeap<Reverse<u64>>,
+    heap: MinQueue,
     fgrid: LooseGrid,
     tets: Vec<[u32; 4]>,
     neigh: Vec<u32>,
@@ -361,16 +360,23 @@ impl SeparatingPlanes {
         SeparatingPlanes { o, n, tol, inv_len }
     }
 
-    /// Some face plane has all of `g` more than `margin` outside it: `g`
-    /// keeps at least `margin` from the tet.
+    /// `d[i][j]`: how far corner `j` of `g` lies outside face plane `i`.
+    #[inline(always)]
+    fn outside(&self, g: &[P3; 3]) -> [[f64; 3]; 4] {
+        // Loops, not `map`: nested array maps were left out of line.
+        let mut d = [[0.0; 3]; 4];
+        for i in 0..4 {
+            for j in 0..3 {
+                d[i][j] = dot(self.n[i], sub(g[j], self.o[i])) * self.inv_len[i];
+            }
+        }
+        d
+    }
+
+    /// Corner `i`'s height over the face opposite it.
     #[inline]
-    fn clear_of(&self, g: &[P3; 3], margin: f64) -> bool {
-        // The base plane first: front faces around the base face lie
-        // mostly under it (any order gives the same answer).
-        [3, 0, 1, 2].into_iter().any(|i| {
-            g.iter()
-                .all(|&x| dot(self.n[i], sub(x, self.o[i])) * self.inv_len[i] > margin)
-        })
+    fn height(&self, tp: &[P3; 4], i: usize) -> f64 {
+        -dot(self.n[i], sub(tp[i], self.o[i])) * self.inv_len[i]
     }
 
     /// `x` is inside the tet grown by `margin` on every face.
@@ -414,8 +420,8 @@ impl SeparatingPlanes {
 }
 
 #[inline]
-fn heap_entry(key: f64, face: u32) -> Reverse<u64> {
-    Reverse(((key as f32).to_bits() as u64) << 32 | face as u64)
+fn heap_entry(key: f64, face: u32) -> u64 {
+    ((key as f32).to_bits() as u64) << 32 | face as u64
 }
 
 #[inline]
@@ -497,7 +503,7 @@ impl<'a> Front<'a> {
             fowner: Vec::new(),
             ftries: Vec::new(),
             fmap: FxHashMap::default(),
-            heap: BinaryHeap::new(),
+            heap: MinQueue::default(),
             fgrid: LooseGrid::new(s0, bb.min),
             tets: Vec::new(),
             neigh: Vec::new(),
@@ -576,7 +582,7 @@ impl<'a> Front<'a> {
         self.fowner.push(owner);
         self.ftries.push(0);
         self.fmap.insert(sorted3(v), id);
-        self.fgrid.insert(id, &tri_box(&self.pts, v));
+        self.fgrid.insert(id, v, &tri_box(&self.pts, v));
         let key = self.face_key(v);
         self.heap.push(heap_entry(key, id));
     }
@@ -602,8 +608,7 @@ impl<'a> Front<'a> {
             self.epoch = 1;
         }
         let epoch = self.epoch;
-        self.fgrid.query(q, |g| {
-            let w = self.fv[g as usize];
+        self.fgrid.query(q, |g, w| {
             let p = w.map(|i| self.pts[i as usize]);
             let bb = bbox(p);
             if !bb.overlaps(q) {
@@ -629,7 +634,7 @@ impl<'a> Front<'a> {
         let mut fewest_stuck = usize::MAX;
         let mut last_gain = 0;
         loop {
-            while let Some(Reverse(e)) = self.heap.pop() {
+            while let Some(e) = self.heap.pop() {
                 let (key, fid) = (f32::from_bits((e >> 32) as u32) as f64, e as u32);
                 if !self.falive[fid as usize] {
                     continue;
@@ -1008,6 +1013,11 @@ impl<'a> Front<'a> {
                 continue;
             }
             let g = nf.p;
+            // Nothing on or under the plane through m is ahead of the ray:
+            // the base face's neighbours, most of what passes the box.
+            if g.iter().all(|&x| dot(sub(x, m), n) <= 0.0) {
+                continue;
+            }
             // Moller-Trumbore; faces through m (t ~ 0) are the neighbours.
             let e1 = sub(g[1], g[0]);
             let e2 = sub(g[2], g[0]);
@@ -1061,6 +1071,7 @@ impl<'a> Front<'a> {
         // boxes cannot meet (exact, the boxes are of the coordinates).
         let nfb: [Aabb; 3] = nfp.map(bbox);
         let planes = SeparatingPlanes::new(&tp);
+        let heights = [0, 1, 2].map(|i| planes.height(&tp, i));
         let m_apex = if is_new_point(q) {
             cl.new_point.max(margin)
         } else {
@@ -1093,13 +1104,38 @@ impl<'a> Front<'a> {
             // Nor may a new edge pass close by a front edge: two edges
             // crossing a hair apart leave a slab between their faces that
             // only slivers fill (thin plates of CAD needles).
-            if em > 0.0 && !planes.clear_of(gp, em) {
+            let d = planes.outside(gp);
+            // Some plane has all of `g` more than `em` outside: it keeps
+            // that far from the tet.
+            if em > 0.0 && !d.iter().any(|di| di.iter().all(|&x| x > em)) {
                 // Front edge k against new edge e = (tv[e], q), by the tet's
                 // local indices: one front edge's box serves all three.
                 for k in 0..3 {
-                    let (l0, l1) = (gl[k], gl[(k + 1) % 3]);
+                    let k1 = (k + 1) % 3;
+                    let (l0, l1) = (gl[k], gl[k1]);
                     if l0 == 3 || l1 == 3 || (l0 < 4 && l1 < 4) {
                         continue; // ends at the apex, or an edge of the tet
+                    }
+                    if l0 == 4 && l1 == 4 {
+                        if d.iter().any(|di| di[k] > em && di[k1] > em) {
+                            continue; // a plane keeps the edge `em` off the tet
+                        }
+                    } else {
+                        // From base corner a = tv[la] to x, outside a plane
+                        // through a by dx: its points at a + s (x - a) keep
+                        // s dx from the tet and h_a - s |x - a| from the
+                        // face opposite a, which holds every new edge
+                        // without a; so at least h_a dx / (dx + |x - a|).
+                        let (la, j, ja) = if l0 < 4 { (l0, k1, k) } else { (l1, k, k1) };
+                        let dx = (0..4)
+                            .filter(|&i| i != la)
+                            .map(|i| d[i][j])
+                            .fold(f64::NEG_INFINITY, f64::max);
+                        if dx > 0.0
+                            && heights[la] * dx > em * (dx + dist(gp[j], gp[ja])) * (1.0 + 1e-9)
+                        {
+                            continue;
+                        }
                     }
                     let (x0, x1) = (gp[k], gp[(k + 1) % 3]);
                     let sb = bbox([x0, x1]);
