@@ -76,6 +76,18 @@ fn floor_i64(x: f64) -> i64 {
     t.saturating_sub(((t as f64) > x) as i64)
 }
 
+#[inline(always)]
+fn prefetch<T>(p: *const T) {
+    #[cfg(target_arch = "x86_64")]
+    // SAFETY: a prefetch is a hint; it never faults, whatever the address.
+    unsafe {
+        use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
+        _mm_prefetch::<_MM_HINT_T0>(p as *const i8);
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = p;
+}
+
 #[inline]
 fn down(x: f64) -> f32 {
     let y = x as f32;
@@ -246,16 +258,29 @@ impl LooseGrid {
                 }
                 continue;
             }
+            // The cells first, each prefetched, then their items: the
+            // loads of one cell's items overlap the next one's misses.
+            let mut found = [0u32; 64];
+            let mut n = 0;
             for x in lo[0]..=hi[0] {
                 for y in lo[1]..=hi[1] {
                     for z in lo[2]..=hi[2] {
                         // Wrapped keys can alias: the box test filters.
                         if let Some(&c) = lv.heads.get(&cell_key([x, y, z])) {
-                            scan(&self.cells[c as usize]);
+                            if n == found.len() {
+                                found.iter().for_each(|&c| scan(&self.cells[c as usize]));
+                                n = 0;
+                            }
+                            prefetch(self.cells[c as usize].as_ptr());
+                            found[n] = c;
+                            n += 1;
                         }
                     }
                 }
             }
+            found[..n]
+                .iter()
+                .for_each(|&c| scan(&self.cells[c as usize]));
         }
     }
 

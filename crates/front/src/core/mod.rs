@@ -196,6 +196,19 @@ fn is_new_point(q: u32) -> bool {
     q >= NONE - 3
 }
 
+/// Each of `g`'s ids' index in `tv`, or 4: by selects, not `position`
+/// in a `map` (left out of line, once per near face).
+#[inline(always)]
+fn local_ids(g: [u32; 3], tv: [u32; 4]) -> [usize; 3] {
+    let mut gl = [4usize; 3];
+    for j in 0..3 {
+        for i in (0..4).rev() {
+            gl[j] = if g[j] == tv[i] { i } else { gl[j] };
+        }
+    }
+    gl
+}
+
 #[inline]
 fn sorted3(v: [u32; 3]) -> [u32; 3] {
     let mut k = v;
@@ -1065,8 +1078,14 @@ impl<'a> Front<'a> {
         ];
         let tb = bbox(tp);
         // The three new faces, built once rather than per near face.
-        let nfv: [[u32; 3]; 3] = [0, 1, 2].map(|i| TET_FACES[i].map(|k| tv[k]));
-        let nfp: [[P3; 3]; 3] = [0, 1, 2].map(|i| TET_FACES[i].map(|k| tp[k]));
+        let mut nfv = [[0u32; 3]; 3];
+        let mut nfp = [[[0.0; 3]; 3]; 3];
+        for i in 0..3 {
+            for j in 0..3 {
+                nfv[i][j] = tv[TET_FACES[i][j]];
+                nfp[i][j] = tp[TET_FACES[i][j]];
+            }
+        }
         // Their boxes: closed triangles with no common corner and apart
         // boxes cannot meet (exact, the boxes are of the coordinates).
         let nfb: [Aabb; 3] = nfp.map(bbox);
@@ -1088,7 +1107,7 @@ impl<'a> Front<'a> {
             }
             let g = nf.v;
             let gp = &nf.p;
-            let gl = g.map(|x| tv.iter().position(|&y| y == x).unwrap_or(4));
+            let gl = local_ids(g, tv);
             // The apex keeps clear of front faces too, not only of front
             // points: a long face has its corners far away, and a tet that
             // hovers over its middle leaves a slab only slivers can fill.
