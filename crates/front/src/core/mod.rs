@@ -401,16 +401,24 @@ impl SeparatingPlanes {
     /// `gl[j]`: the tet's local index of `g[j]` when it is a tet corner,
     /// else 4. A plane through every shared corner with the other corners
     /// strictly outside leaves `g` meeting the tet in shared corners only.
+    /// `out`: `outside(g)`, whose signs are the float signs of the same
+    /// dot products: planes they rule out are not computed again.
     #[inline]
-    fn separates(&self, g: &[P3; 3], gl: [usize; 3]) -> bool {
-        // The base plane first, as in `clear_of`.
+    fn separates(&self, g: &[P3; 3], gl: [usize; 3], out: &[[f64; 3]; 4]) -> bool {
+        // The base plane first: front faces around the base face lie
+        // mostly under it (any order gives the same answer).
         'planes: for i in [3, 0, 1, 2] {
+            let mut maybe = true;
+            for j in 0..3 {
+                // Plane i does not hold corner i; other corners must be out.
+                maybe &= if gl[j] < 4 { gl[j] != i } else { out[i][j] > 0.0 };
+            }
+            if !maybe {
+                continue;
+            }
             let mut outside = 0;
             for j in 0..3 {
                 if gl[j] < 4 {
-                    if gl[j] == i {
-                        continue 'planes; // plane i does not hold this corner
-                    }
                     continue;
                 }
                 let d = sub(g[j], self.o[i]);
@@ -1126,7 +1134,12 @@ impl<'a> Front<'a> {
             let d = planes.outside(gp);
             // Some plane has all of `g` more than `em` outside: it keeps
             // that far from the tet.
-            if em > 0.0 && !d.iter().any(|di| di.iter().all(|&x| x > em)) {
+            // (`&` and `|`, not `&&` and `||`: the branches mispredict.)
+            let mut clear = false;
+            for di in &d {
+                clear |= (di[0] > em) & (di[1] > em) & (di[2] > em);
+            }
+            if em > 0.0 && !clear {
                 // Front edge k against new edge e = (tv[e], q), by the tet's
                 // local indices: one front edge's box serves all three.
                 for k in 0..3 {
@@ -1136,7 +1149,11 @@ impl<'a> Front<'a> {
                         continue; // ends at the apex, or an edge of the tet
                     }
                     if l0 == 4 && l1 == 4 {
-                        if d.iter().any(|di| di[k] > em && di[k1] > em) {
+                        let mut off = false;
+                        for di in &d {
+                            off |= (di[k] > em) & (di[k1] > em);
+                        }
+                        if off {
                             continue; // a plane keeps the edge `em` off the tet
                         }
                     } else {
@@ -1146,12 +1163,15 @@ impl<'a> Front<'a> {
                         // face opposite a, which holds every new edge
                         // without a; so at least h_a dx / (dx + |x - a|).
                         let (la, j, ja) = if l0 < 4 { (l0, k1, k) } else { (l1, k, k1) };
-                        let dx = (0..4)
-                            .filter(|&i| i != la)
-                            .map(|i| d[i][j])
-                            .fold(f64::NEG_INFINITY, f64::max);
-                        if dx > 0.0
-                            && heights[la] * dx > em * (dx + dist(gp[j], gp[ja])) * (1.0 + 1e-9)
+                        // Squared, without the root: (h_a - em') dx > em' |x - a|.
+                        let mut dx = f64::NEG_INFINITY;
+                        for (i, di) in d.iter().enumerate() {
+                            dx = if i != la && di[j] > dx { di[j] } else { dx };
+                        }
+                        let em1 = em * (1.0 + 1e-9);
+                        let lift = (heights[la] - em1) * dx;
+                        if (dx > 0.0) & (lift > 0.0)
+                            && lift * lift > em1 * em1 * dist2(gp[j], gp[ja])
                         {
                             continue;
                         }
@@ -1174,7 +1194,7 @@ impl<'a> Front<'a> {
             if nsh == 0 && !tb.overlaps(&nf.bb) {
                 continue; // nothing in common with the tet, not even its box
             }
-            let apart = planes.separates(gp, gl);
+            let apart = planes.separates(gp, gl, &d);
             if apart && nsh < 2 {
                 continue; // no common edge: no matching face, no wedge
             }
