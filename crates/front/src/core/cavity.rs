@@ -58,7 +58,7 @@ impl<'a> Front<'a> {
             if seed >= skip.len() {
                 skip.resize(self.fv.len(), false);
             }
-            if !self.falive[seed] || skip[seed] {
+            if !self.fv[seed].alive || skip[seed] {
                 seed += 1;
                 continue;
             }
@@ -88,13 +88,13 @@ impl<'a> Front<'a> {
         while i < out.len() && out.len() <= MAX_POCKET {
             let f = out[i];
             i += 1;
-            let v = self.fv[f as usize];
+            let v = self.fv[f as usize].v;
             let bb = tri_box(&self.pts, v);
             self.fgrid.query(&bb, |g, _| {
-                if seen.contains_key(&g) || !self.falive[g as usize] {
+                if seen.contains_key(&g) || !self.fv[g as usize].alive {
                     return;
                 }
-                let w = self.fv[g as usize];
+                let w = self.fv[g as usize].v;
                 if w.iter().filter(|x| v.contains(x)).count() >= 2 {
                     seen.insert(g, ());
                     out.push(g);
@@ -132,7 +132,7 @@ impl<'a> Front<'a> {
             // Grow: the tets behind the badly seen faces leave.
             let mut dead: Vec<u32> = bad
                 .iter()
-                .map(|&f| self.fowner[f as usize])
+                .map(|&f| self.fv[f as usize].owner)
                 .filter(|&o| o != NONE)
                 .map(|o| o >> 2)
                 .collect();
@@ -251,7 +251,7 @@ impl<'a> Front<'a> {
         let mut take = Vec::new();
         for &f in pocket {
             // A failed close_by_existing re-adds its faces under new ids.
-            if !self.falive[f as usize] || self.cone_shape(f, p) < 10.0 * CONE_FLOOR {
+            if !self.fv[f as usize].alive || self.cone_shape(f, p) < 10.0 * CONE_FLOOR {
                 continue;
             }
             let cl = Clearance {
@@ -312,7 +312,7 @@ impl<'a> Front<'a> {
         faces
             .iter()
             .map(|&f| {
-                let [a, b, d] = self.fv[f as usize].map(|i| self.pts[i as usize]);
+                let [a, b, d] = self.fv[f as usize].v.map(|i| self.pts[i as usize]);
                 (a, tri_normal(a, b, d))
             })
             .collect()
@@ -334,7 +334,7 @@ impl<'a> Front<'a> {
     fn faces_box(&self, faces: &[u32]) -> Aabb {
         let mut bb = Aabb::EMPTY;
         for &f in faces {
-            for i in self.fv[f as usize] {
+            for i in self.fv[f as usize].v {
                 bb.grow(self.pts[i as usize]);
             }
         }
@@ -345,7 +345,7 @@ impl<'a> Front<'a> {
     fn mean_edge(&self, faces: &[u32]) -> f64 {
         let mut s = 0.0;
         for &f in faces {
-            let v = self.fv[f as usize].map(|i| self.pts[i as usize]);
+            let v = self.fv[f as usize].v.map(|i| self.pts[i as usize]);
             s += (dist(v[0], v[1]) + dist(v[1], v[2]) + dist(v[2], v[0])) / 3.0;
         }
         s / faces.len().max(1) as f64
@@ -380,7 +380,7 @@ impl<'a> Front<'a> {
         let mut set: Vec<u32> = pocket
             .iter()
             .copied()
-            .filter(|&f| self.falive[f as usize])
+            .filter(|&f| self.fv[f as usize].alive)
             .collect();
         let bb = self.faces_box(&set);
         let tiny = 1e-6 * bb.diagonal();
@@ -399,7 +399,7 @@ impl<'a> Front<'a> {
                 .iter()
                 .enumerate()
                 .map(|(k, &f)| {
-                    let [a, b, d] = self.fv[f as usize].map(|i| self.pts[i as usize]);
+                    let [a, b, d] = self.fv[f as usize].v.map(|i| self.pts[i as usize]);
                     (dot(normalize(tri_normal(a, b, d)), sub(x, a)), k)
                 })
                 .min_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)))
@@ -411,11 +411,11 @@ impl<'a> Front<'a> {
         let live: Vec<u32> = pocket
             .iter()
             .copied()
-            .filter(|&f| self.falive[f as usize])
+            .filter(|&f| self.fv[f as usize].alive)
             .collect();
         let mut by_edge: FxHashMap<(u32, u32), Vec<u32>> = FxHashMap::default();
         for &f in &live {
-            let v = self.fv[f as usize];
+            let v = self.fv[f as usize].v;
             for k in 0..3 {
                 let (a, b) = (v[k], v[(k + 1) % 3]);
                 by_edge.entry((a.min(b), a.max(b))).or_default().push(f);
@@ -428,7 +428,7 @@ impl<'a> Front<'a> {
             while i < patch.len() && patch.len() < MAX_PATCH {
                 let f = patch[i];
                 i += 1;
-                let v = self.fv[f as usize];
+                let v = self.fv[f as usize].v;
                 for k in 0..3 {
                     let (a, b) = (v[k], v[(k + 1) % 3]);
                     for &g in &by_edge[&(a.min(b), a.max(b))] {
@@ -477,7 +477,7 @@ impl<'a> Front<'a> {
             next: usize,
             tet: u32,
         }
-        let mut corners: Vec<u32> = pocket.iter().flat_map(|&f| self.fv[f as usize]).collect();
+        let mut corners: Vec<u32> = pocket.iter().flat_map(|&f| self.fv[f as usize].v).collect();
         corners.sort_unstable();
         corners.dedup();
         let mut faces: Vec<u32> = pocket.to_vec();
@@ -493,7 +493,7 @@ impl<'a> Front<'a> {
                 // The most constrained face: fewest corners it could reach.
                 let mut pick: Option<(usize, [u32; 3], u32)> = None;
                 for &f in &faces {
-                    let v = self.fv[f as usize];
+                    let v = self.fv[f as usize].v;
                     let [a, b, c] = v.map(|i| self.pts[i as usize]);
                     let n = corners
                         .iter()
@@ -508,7 +508,7 @@ impl<'a> Front<'a> {
                     }
                 }
                 let (_, _, f) = pick.expect("faces is not empty");
-                let v = self.fv[f as usize];
+                let v = self.fv[f as usize].v;
                 let [a, b, c] = v.map(|i| self.pts[i as usize]);
                 let mut cands: Vec<(f64, u32)> = corners
                     .iter()
@@ -584,14 +584,14 @@ impl<'a> Front<'a> {
     }
 
     fn prohibited_face(&self, f: u32) -> bool {
-        let v = self.fv[f as usize];
+        let v = self.fv[f as usize].v;
         v.iter()
             .any(|&p| !self.region.point_ok(self.pts[p as usize]))
     }
 
     #[inline]
     fn cone_shape(&self, f: u32, p: P3) -> f64 {
-        let v = self.fv[f as usize];
+        let v = self.fv[f as usize].v;
         mean_ratio(
             self.pts[v[0] as usize],
             self.pts[v[1] as usize],
@@ -618,7 +618,7 @@ impl<'a> Front<'a> {
         let mut c = [0.0; 3];
         let mut hsum = 0.0;
         for &f in pocket {
-            let v = self.fv[f as usize];
+            let v = self.fv[f as usize].v;
             let [a, b, d] = v.map(|i| self.pts[i as usize]);
             let m = centroid3(a, b, d);
             c = add(c, m);
@@ -630,7 +630,7 @@ impl<'a> Front<'a> {
         cands.push(c);
         let stride = (pocket.len() / 48).max(1);
         for &f in pocket.iter().step_by(stride) {
-            let v = self.fv[f as usize];
+            let v = self.fv[f as usize].v;
             let [a, b, d] = v.map(|i| self.pts[i as usize]);
             let m = centroid3(a, b, d);
             let nrm = normalize(tri_normal(a, b, d));
@@ -689,7 +689,7 @@ impl<'a> Front<'a> {
     /// The tet on face `f` with apex `p` (point `q`, or `NONE` for a new
     /// one) is positive and free, checked against the front around it alone.
     fn apex_free(&mut self, f: u32, q: u32, p: P3, cl: Clearance) -> bool {
-        let v = self.fv[f as usize];
+        let v = self.fv[f as usize].v;
         let [a, b, c] = v.map(|i| self.pts[i as usize]);
         if orient3d(a, b, c, p) <= 0.0 {
             return false;
@@ -709,14 +709,14 @@ impl<'a> Front<'a> {
             .iter()
             .copied()
             .chain(before..self.fv.len() as u32)
-            .find(|&f| self.falive[f as usize])
+            .find(|&f| self.fv[f as usize].alive)
     }
 
     /// `faces` after a commit or an undo: the live ones, and those made
     /// since `before`.
     fn refresh(&self, faces: &mut Vec<u32>, before: u32) {
-        faces.retain(|&g| self.falive[g as usize]);
-        faces.extend((before..self.fv.len() as u32).filter(|&g| self.falive[g as usize]));
+        faces.retain(|&g| self.fv[g as usize].alive);
+        faces.extend((before..self.fv.len() as u32).filter(|&g| self.fv[g as usize].alive));
     }
 
     fn commit_cone(&mut self, pocket: &[u32], p: P3) {

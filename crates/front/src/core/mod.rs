@@ -146,6 +146,18 @@ enum Outcome {
     Prohibited,
 }
 
+/// A front face. One record, not four arrays: the face popped from the
+/// queue is anywhere in millions of ids, and each array cost a miss.
+#[derive(Clone, Copy)]
+struct Face {
+    v: [u32; 3],
+    /// The tet face behind it, `4t+f`, or `NONE` for an input face.
+    owner: u32,
+    /// Attempts so far (AF2 retries).
+    tries: u8,
+    alive: bool,
+}
+
 #[derive(Clone, Copy)]
 struct Near {
     v: [u32; 3],
@@ -159,10 +171,8 @@ struct Front<'a> {
     pts: Vec<P3>,
     hp: Vec<f64>,
     n_input: usize,
-    fv: Vec<[u32; 3]>,
-    falive: Vec<bool>,
-    fowner: Vec<u32>,
-    ftries: Vec<u8>,
+    /// Every face ever made, by id (dead ones too: ids stay put).
+    fv: Vec<Face>,
     fmap: FxHashMap<[u32; 3], u32>,
     /// AF1's queue: `key << 32 | face`, the key an `f32` size (positive
     /// floats order as their bits), so one entry is 8 bytes.
@@ -520,9 +530,6 @@ impl<'a> Front<'a> {
             hp: input.point_size,
             n_input: n,
             fv: Vec::new(),
-            falive: Vec::new(),
-            fowner: Vec::new(),
-            ftries: Vec::new(),
             fmap: FxHashMap::default(),
             heap: MinQueue::default(),
             fgrid: LooseGrid::new(s0, bb.min),
@@ -598,10 +605,12 @@ impl<'a> Front<'a> {
 
     fn add_face(&mut self, v: [u32; 3], owner: u32) {
         let id = self.fv.len() as u32;
-        self.fv.push(v);
-        self.falive.push(true);
-        self.fowner.push(owner);
-        self.ftries.push(0);
+        self.fv.push(Face {
+            v,
+            owner,
+            tries: 0,
+            alive: true,
+        });
         self.fmap.insert(sorted3(v), id);
         self.fgrid.insert(id, v, &tri_box(&self.pts, v));
         let key = self.face_key(v);
@@ -610,9 +619,9 @@ impl<'a> Front<'a> {
 
     fn remove_face(&mut self, id: u32) {
         let i = id as usize;
-        debug_assert!(self.falive[i]);
-        self.falive[i] = false;
-        let v = self.fv[i];
+        debug_assert!(self.fv[i].alive);
+        self.fv[i].alive = false;
+        let v = self.fv[i].v;
         self.fmap.remove(&sorted3(v));
         self.fgrid.remove(id, &tri_box(&self.pts, v));
     }
@@ -657,7 +666,7 @@ impl<'a> Front<'a> {
         loop {
             while let Some(e) = self.heap.pop() {
                 let (key, fid) = (f32::from_bits((e >> 32) as u32) as f64, e as u32);
-                if !self.falive[fid as usize] {
+                if !self.fv[fid as usize].alive {
                     continue;
                 }
                 match self.try_face(fid) {
@@ -669,7 +678,7 @@ impl<'a> Front<'a> {
                     Outcome::Prohibited => self.prohibited.push(fid),
                     Outcome::Failed => {
                         self.stats.retries += 1;
-                        let t = &mut self.ftries[fid as usize];
+                        let t = &mut self.fv[fid as usize].tries;
                         *t += 1;
                         if *t < self.opts.tries_per_face {
                             // Later, when its surroundings have changed.
@@ -680,7 +689,7 @@ impl<'a> Front<'a> {
                     }
                 }
             }
-            self.stuck.retain(|&f| self.falive[f as usize]);
+            self.stuck.retain(|&f| self.fv[f as usize].alive);
             if self.stuck.is_empty() {
                 return Ok(());
             }
@@ -699,7 +708,7 @@ impl<'a> Front<'a> {
             }
             if self.relax >= self.opts.recovery_rounds || self.relax >= last_gain + STALL_ROUNDS {
                 let f = self.stuck[0];
-                let v = self.fv[f as usize];
+                let v = self.fv[f as usize].v;
                 let c = centroid3(
                     self.pts[v[0] as usize],
                     self.pts[v[1] as usize],
@@ -713,8 +722,8 @@ impl<'a> Front<'a> {
                             .map(|t| self.tets[t])
                             .collect(),
                         front: (0..self.fv.len())
-                            .filter(|&f| self.falive[f])
-                            .map(|f| self.fv[f])
+                            .filter(|&f| self.fv[f].alive)
+                            .map(|f| self.fv[f].v)
                             .collect(),
                     })
                 });
@@ -751,7 +760,7 @@ impl<'a> Front<'a> {
                 held[f as usize] = true;
             }
             self.stuck = (0..self.fv.len() as u32)
-                .filter(|&f| self.falive[f as usize] && !held[f as usize])
+                .filter(|&f| self.fv[f as usize].alive && !held[f as usize])
                 .collect();
             if self.stuck.is_empty() {
                 return;
@@ -772,7 +781,7 @@ impl<'a> Front<'a> {
         };
         let mut mark = vec![false; self.pts.len()];
         for &f in &self.stuck {
-            for &p in &self.fv[f as usize] {
+            for &p in &self.fv[f as usize].v {
                 mark[p as usize] = true;
             }
         }
@@ -809,9 +818,9 @@ impl<'a> Front<'a> {
         self.heap.clear();
         self.prohibited.clear();
         for id in 0..self.fv.len() {
-            if self.falive[id] {
-                self.ftries[id] = 0;
-                let key = self.face_key(self.fv[id]);
+            if self.fv[id].alive {
+                self.fv[id].tries = 0;
+                let key = self.face_key(self.fv[id].v);
                 self.heap.push(heap_entry(key, id as u32));
             }
         }
@@ -837,7 +846,7 @@ impl<'a> Front<'a> {
                 continue;
             }
             match self.fmap.get(&sorted3(w)) {
-                Some(&g) if self.fowner[g as usize] == fr => self.remove_face(g),
+                Some(&g) if self.fv[g as usize].owner == fr => self.remove_face(g),
                 found => {
                     // An input face: it faces the hole again.
                     debug_assert!(found.is_none(), "face {w:?} twice in the front");
@@ -874,7 +883,7 @@ impl<'a> Front<'a> {
     }
 
     fn try_face(&mut self, fid: u32) -> Outcome {
-        let v = self.fv[fid as usize];
+        let v = self.fv[fid as usize].v;
         let [pa, pb, pc] = v.map(|i| self.pts[i as usize]);
         // §7: a face with a point or an edge outside the region is skipped.
         if !(self.point_in(v[0]) && self.point_in(v[1]) && self.point_in(v[2])) {
@@ -906,7 +915,7 @@ impl<'a> Front<'a> {
         // Wider searches on later rounds, but bounded: near lists grow as r^3.
         let relax = self.relax.min(2) as f64;
         let r =
-            h.max(emax) * (SEARCH_RADIUS + 0.35 * relax + 0.25 * self.ftries[fid as usize] as f64);
+            h.max(emax) * (SEARCH_RADIUS + 0.35 * relax + 0.25 * self.fv[fid as usize].tries as f64);
         let cq = add(m, scale(nrm, 0.5 * alpha));
         let qbox = Aabb { min: cq, max: cq }
             .inflated(r)
@@ -955,7 +964,7 @@ impl<'a> Front<'a> {
         // New points: the ideal one, and lower ones once a face has failed
         // (a narrow gap has room for a flat tet only). Id NONE - k codes
         // height k.
-        let tries = self.ftries[fid as usize] as u32 + self.relax;
+        let tries = self.fv[fid as usize].tries as u32 + self.relax;
         let heights: &[f64] = if tries == 0 {
             &[1.0]
         } else {
@@ -982,7 +991,7 @@ impl<'a> Front<'a> {
         // Relative to the best this face allows: a needle surface triangle
         // makes no good tet at all, and must not wait for recovery.
         let best = candidate_score(pa, pb, pc, pstar, h).0;
-        let min_score: f64 = match self.relax + self.ftries[fid as usize] as u32 {
+        let min_score: f64 = match self.relax + self.fv[fid as usize].tries as u32 {
             0 => 0.12f64,
             1 => 0.05,
             2 => 0.01,
@@ -990,7 +999,7 @@ impl<'a> Front<'a> {
         }
         .min(0.3 * best);
         // Kept clear of other front points (a fraction of the size).
-        let cl = Clearance::for_round(self.relax + self.ftries[fid as usize] as u32, h);
+        let cl = Clearance::for_round(self.relax + self.fv[fid as usize].tries as u32, h);
         let mut placed = None;
         for &(score, q) in &cands {
             let s = if score >= 1.0 { score - 1.0 } else { score };
@@ -1248,7 +1257,7 @@ impl<'a> Front<'a> {
 
     /// AF3-AF5: add the tet, its new point, and update the front.
     fn commit(&mut self, fid: u32, q: u32, pq: P3) {
-        let v = self.fv[fid as usize];
+        let v = self.fv[fid as usize].v;
         let q = if is_new_point(q) {
             let id = self.pts.len() as u32;
             let h = self.new_point_size(v, pq);
@@ -1265,7 +1274,7 @@ impl<'a> Front<'a> {
         self.talive.push(true);
         self.neigh.extend_from_slice(&[NONE; 4]);
         self.stats.tets += 1;
-        let owner = self.fowner[fid as usize];
+        let owner = self.fv[fid as usize].owner;
         self.neigh[4 * t as usize + 3] = owner;
         if owner != NONE {
             self.neigh[owner as usize] = 4 * t + 3;
@@ -1275,7 +1284,7 @@ impl<'a> Front<'a> {
             let w = TET_FACES[i].map(|k| tv[k]);
             let fr = 4 * t + i as u32;
             if let Some(&g) = self.fmap.get(&sorted3(w)) {
-                let o = self.fowner[g as usize];
+                let o = self.fv[g as usize].owner;
                 self.neigh[fr as usize] = o;
                 if o != NONE {
                     self.neigh[o as usize] = fr;
@@ -1300,15 +1309,15 @@ impl<'a> Front<'a> {
     fn finish(self) -> FrontResult {
         // The search structures go first: the output is built in place, so
         // the peak is the front's own.
-        drop((self.heap, self.fmap, self.fgrid, self.fowner, self.ftries));
+        drop((self.heap, self.fmap, self.fgrid));
         drop((self.near_f, self.near_p, self.cands, self.stamp, self.stuck));
         let front: Vec<[u32; 3]> = self
             .prohibited
             .iter()
-            .filter(|&&f| self.falive[f as usize])
-            .map(|&f| self.fv[f as usize])
+            .filter(|&&f| self.fv[f as usize].alive)
+            .map(|&f| self.fv[f as usize].v)
             .collect();
-        drop((self.fv, self.falive));
+        drop(self.fv);
         let (mut tets, mut neigh, talive) = (self.tets, self.neigh, self.talive);
         let nt = tets.len();
         let mut tmap = vec![NONE; nt];
