@@ -10,7 +10,7 @@
 //! The cells follow from the front and `parts` alone, and the passes'
 //! messages are ordered by part: the DDG depends on `parts`, never on the
 //! threads.
-use crate::{parallel_pass, peel_stuck, seed_parts, serial_pass, PassError, Regions};
+use crate::{parallel_pass, peel_stuck, seed_parts, serial_pass, PassError, Regions, Sizes};
 use parafront_comm::Comm;
 use parafront_ddg::{self as ddg, Ddg, DdgMode};
 use parafront_front::RegionFilter;
@@ -218,12 +218,14 @@ fn frame(j: usize) -> [P3; 3] {
 }
 
 /// The DDG's surface points get this many times their mean edge length
-/// as their size: the first layer of tets as tall as the front makes them
-/// (at most twice a face's longest edge). §5 multiplies the initial sizes
-/// by `c`; with 2 instead of 1.6 the DDG of sphere_1e6 has 131k tets
-/// instead of 213k (257k at 1), in half the time: tall tets on
-/// neighbouring surface triangles share their apexes.
-pub const FIRST_LAYER: f64 = 2.0;
+/// as their size, and its fronts let a tet grow that tall over a face
+/// (`FrontOptions::max_growth`; the fine mesh's 2). §5 multiplies the
+/// initial sizes by `c`; tall tets on neighbouring surface triangles share
+/// their apexes. sphere_1e6: 131k tets at 2 instead of 213k at 1.6, in half
+/// the time; sphere_5e6 (P = 8, 1 thread): 362k tets in 5.0 s at 2, 299k
+/// in 4.8 s at 2.5, 250k in 4.7 s at 3, 200k in 3.7 s at 4, 177k in 4.3 s
+/// at 5, 162k in 5.0 s at 6 (each front query holds more surface faces).
+pub const FIRST_LAYER: f64 = 4.0;
 
 /// Recovery rounds of the serial pass's tries. Every smooth surface closes
 /// by the second try (the corpus and the 1e5 bench surfaces, P = 8 to
@@ -257,6 +259,10 @@ pub fn build_ddg<C: Comm>(
     // DDG of sphere_5e6 has 429k tets instead of 362k.
     let field = ddg::GradedField::of_sizes(points, &point_size, (c - 1.0).max(0.0));
     let field = move |p: P3| field.size(p);
+    let sizes = Sizes {
+        field: &field,
+        max_growth: FIRST_LAYER,
+    };
     st.field_seconds = t0.elapsed().as_secs_f64();
     let domain = Aabb::from_points(points.iter());
     let domain = domain.inflated(1e-6 * domain.diagonal().max(1e-300));
@@ -288,8 +294,7 @@ pub fn build_ddg<C: Comm>(
             break;
         }
         let cells = Cells::new(&cen, np, frame(j), &domain);
-        let (tets, _) =
-            parallel_pass(&mut parts, comm, &cells, &field, j as u8 + 1, &mut next_gid)?;
+        let (tets, _) = parallel_pass(&mut parts, comm, &cells, sizes, j as u8 + 1, &mut next_gid)?;
         let peeled = peel_stuck(&mut parts, comm);
         if debug {
             let fr: usize = parts.iter().map(|p| p.front.len()).sum();
@@ -304,7 +309,7 @@ pub fn build_ddg<C: Comm>(
         st.pass_seconds.push(t0.elapsed().as_secs_f64());
     }
     let t0 = Instant::now();
-    let (made, _) = serial_pass(&mut parts, comm, &field, &mut next_gid, &DDG_SERIAL_ROUNDS)?;
+    let (made, _) = serial_pass(&mut parts, comm, sizes, &mut next_gid, &DDG_SERIAL_ROUNDS)?;
     if debug {
         eprintln!(
             "ddg serial pass: {made} tets, {:.3} s",

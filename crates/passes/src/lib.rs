@@ -438,7 +438,7 @@ pub fn mesh_parallel<C: Comm>(
             &mut parts,
             comm,
             &regions,
-            size,
+            Sizes::fine(size),
             label as u8 + 1,
             &mut next_gid,
         )?;
@@ -491,7 +491,13 @@ pub fn mesh_parallel<C: Comm>(
 
     // Pass 4: what is left, serially on part 0.
     let t0 = Instant::now();
-    let (made4, removed) = serial_pass(&mut parts, comm, size, &mut next_gid, &PASS4_ROUNDS)?;
+    let (made4, removed) = serial_pass(
+        &mut parts,
+        comm,
+        Sizes::fine(size),
+        &mut next_gid,
+        &PASS4_ROUNDS,
+    )?;
     st.pass_tets[3] = made4;
     st.peeled_tets += removed;
     st.pass_seconds[3] = t0.elapsed().as_secs_f64();
@@ -519,11 +525,29 @@ pub fn mesh_parallel<C: Comm>(
 /// box it meets (so that each part knows every face bounding its region);
 /// every part advances its faces; new points get global ids. Returns the
 /// tets and the front seconds of each part.
+/// How the passes' fronts size new tets: the field, and the tallest tet
+/// over a face, in its longest edges (`FrontOptions::max_growth`).
+#[derive(Clone, Copy)]
+pub(crate) struct Sizes<'a> {
+    pub(crate) field: &'a (dyn Fn(P3) -> f64 + Sync),
+    pub(crate) max_growth: f64,
+}
+
+impl<'a> Sizes<'a> {
+    /// The fine mesh's: the front's default growth.
+    fn fine(field: &'a (dyn Fn(P3) -> f64 + Sync)) -> Sizes<'a> {
+        Sizes {
+            field,
+            max_growth: parafront_front::MAX_GROWTH_PER_TET,
+        }
+    }
+}
+
 fn parallel_pass<C: Comm>(
     parts: &mut [Part],
     comm: &C,
     regions: &dyn Regions,
-    size: &(dyn Fn(P3) -> f64 + Sync),
+    size: Sizes<'_>,
     pass: u8,
     next_gid: &mut u32,
 ) -> Result<(Vec<usize>, Vec<f64>), PassError> {
@@ -616,7 +640,7 @@ fn front_call(
     inbox: Vec<(u32, FaceMsg)>,
     k: u32,
     regions: &dyn Regions,
-    size: &(dyn Fn(P3) -> f64 + Sync),
+    size: Sizes<'_>,
 ) -> Result<Made, (usize, FrontError)> {
     let t0 = Instant::now();
     if !inbox.iter().any(|m| m.1.owned) {
@@ -644,10 +668,11 @@ fn front_call(
         .collect();
     let res = advance(
         input,
-        SizeMode::Field(size),
+        SizeMode::Field(size.field),
         &*filter,
         &FrontOptions {
             pass: true,
+            max_growth: size.max_growth,
             ..FrontOptions::default()
         },
     )
@@ -658,7 +683,7 @@ fn front_call(
     let pocket_tets = close_pockets(
         &mut res,
         |i| i as usize >= n_in || input_ok[i as usize],
-        size,
+        size.field,
     );
     let t_pockets = t0.elapsed().as_secs_f64() - t_front;
     let stuck: Vec<bool> = res
@@ -1119,7 +1144,7 @@ const PASS4_ROUNDS: [u32; 5] = [1, 12, 12, 12, 60];
 fn serial_pass<C: Comm>(
     parts: &mut [Part],
     comm: &C,
-    size: &(dyn Fn(P3) -> f64 + Sync),
+    size: Sizes<'_>,
     next_gid: &mut u32,
     rounds: &[u32],
 ) -> Result<(usize, usize), PassError> {
@@ -1164,7 +1189,7 @@ fn serial_pass<C: Comm>(
         let t0 = Instant::now();
         let res = advance(
             input,
-            SizeMode::Field(size),
+            SizeMode::Field(size.field),
             &Everywhere,
             &FrontOptions {
                 // Bounded: peeling a layer is the better next step. The first
@@ -1172,6 +1197,7 @@ fn serial_pass<C: Comm>(
                 // filling (round 2 on) trips on some left-over fronts.
                 recovery_rounds: rounds[peel],
                 keep_partial: peel < last,
+                max_growth: size.max_growth,
                 ..FrontOptions::default()
             },
         );

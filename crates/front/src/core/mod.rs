@@ -26,8 +26,9 @@ const SEARCH_RADIUS: f64 = 0.7;
 const STALL_ROUNDS: u32 = 100;
 /// Marked points a tet needs to leave in a late recovery round.
 const LATE_REMOVAL_POINTS: usize = 2;
-/// A new tet's size is at most this multiple of its face's longest edge.
-const MAX_GROWTH_PER_TET: f64 = 2.0;
+/// A new tet's size is at most this multiple of its face's longest edge
+/// (the default of `FrontOptions::max_growth`).
+pub const MAX_GROWTH_PER_TET: f64 = 2.0;
 
 const NONE: u32 = u32::MAX;
 /// How far a new point keeps from front faces, in sizes, by round.
@@ -59,6 +60,10 @@ pub struct FrontOptions {
     /// On failure, hand back the partial mesh and the stuck front in
     /// `FrontError::Stuck` (issue 3, step 5.4: a debug dump when asked).
     pub keep_partial: bool,
+    /// A new tet's size is at most this multiple of its face's longest
+    /// edge: sizes then grow geometrically, and a small face under a large
+    /// size (CAD needles) keeps a local search. The DDG allows more.
+    pub max_growth: f64,
 }
 
 impl Default for FrontOptions {
@@ -71,6 +76,7 @@ impl Default for FrontOptions {
             progress: None,
             pass: false,
             keep_partial: false,
+            max_growth: MAX_GROWTH_PER_TET,
         }
     }
 }
@@ -421,7 +427,11 @@ impl SeparatingPlanes {
             let mut maybe = true;
             for j in 0..3 {
                 // Plane i does not hold corner i; other corners must be out.
-                maybe &= if gl[j] < 4 { gl[j] != i } else { out[i][j] > 0.0 };
+                maybe &= if gl[j] < 4 {
+                    gl[j] != i
+                } else {
+                    out[i][j] > 0.0
+                };
             }
             if !maybe {
                 continue;
@@ -901,7 +911,7 @@ impl<'a> Front<'a> {
         // A tet at most twice its face: sizes still grow geometrically, and a
         // small face under a large size (CAD needles) keeps a local search.
         let h = ((self.hp[v[0] as usize] + self.hp[v[1] as usize] + self.hp[v[2] as usize]) / 3.0)
-            .min(MAX_GROWTH_PER_TET * emax);
+            .min(self.opts.max_growth * emax);
         let dm = (dist(m, pa) + dist(m, pb) + dist(m, pc)) / 3.0;
         // AF2.1: the ideal point sits at a regular tet's height.
         let mut alpha = (h * h - dm * dm).max(0.25 * dm * dm).sqrt();
@@ -914,8 +924,8 @@ impl<'a> Front<'a> {
         // candidate tet.
         // Wider searches on later rounds, but bounded: near lists grow as r^3.
         let relax = self.relax.min(2) as f64;
-        let r =
-            h.max(emax) * (SEARCH_RADIUS + 0.35 * relax + 0.25 * self.fv[fid as usize].tries as f64);
+        let r = h.max(emax)
+            * (SEARCH_RADIUS + 0.35 * relax + 0.25 * self.fv[fid as usize].tries as f64);
         let cq = add(m, scale(nrm, 0.5 * alpha));
         let qbox = Aabb { min: cq, max: cq }
             .inflated(r)
