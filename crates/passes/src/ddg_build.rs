@@ -14,7 +14,7 @@ use crate::{parallel_pass, peel_stuck, seed_parts, serial_pass, PassError, Regio
 use parafront_comm::Comm;
 use parafront_ddg::{self as ddg, Ddg, DdgMode};
 use parafront_front::RegionFilter;
-use parafront_geom::{dot, Aabb, P3};
+use parafront_geom::{cross, dist, dot, norm, sub, Aabb, P3};
 use std::time::Instant;
 
 /// What building the DDG did, pass by pass.
@@ -219,13 +219,40 @@ fn frame(j: usize) -> [P3; 3] {
 
 /// The DDG's surface points get this many times their mean edge length
 /// as their size, and its fronts let a tet grow that tall over a face
-/// (`FrontOptions::max_growth`; the fine mesh's 2). §5 multiplies the
+/// (`FrontOptions::max_growth`, the fine mesh's 2). §5 multiplies the
 /// initial sizes by `c`; tall tets on neighbouring surface triangles share
 /// their apexes. sphere_1e6: 131k tets at 2 instead of 213k at 1.6, in half
-/// the time; sphere_5e6 (P = 8, 1 thread): 362k tets in 5.0 s at 2, 299k
-/// in 4.8 s at 2.5, 250k in 4.7 s at 3, 200k in 3.7 s at 4, 177k in 4.3 s
-/// at 5, 162k in 5.0 s at 6 (each front query holds more surface faces).
-pub const FIRST_LAYER: f64 = 4.0;
+/// the time.
+pub const FIRST_LAYER: f64 = 2.0;
+
+/// The first layer of a deep domain ([`DEEP`]). sphere_5e6 (P = 8, one
+/// thread): 362k tets in 5.0 s at 2, 299k in 4.8 s at 2.5, 250k in 4.7 s
+/// at 3, 200k in 3.7 s at 4, 177k in 4.3 s at 5, 162k in 5.0 s at 6 (each
+/// front query then holds more surface faces).
+pub const DEEP_FIRST_LAYER: f64 = 4.0;
+
+/// A domain this many mean surface edges deep (volume over area) takes
+/// the taller first layer: only there is the DDG's cost a share worth
+/// cutting (tets per surface triangle grow with the depth). Elsewhere tall
+/// tets wedge in thin walls and narrow gaps: at 4 the DDG fails on the tray
+/// after 133 s instead of 15 s, and on fertility at P = 32 (depth 1.7).
+/// Depths: the CAD plates 0.1-0.4, the other corpus parts 1.7-9.6 (the
+/// skull), the 1e5 bench surfaces 3.2-5.8, sphere_1e6 12.5, box2holes_5e6
+/// 11.4 (no faster at 4: 4.7 s against 4.9), sphere_5e6 21.3.
+pub const DEEP: f64 = 10.0;
+
+/// Volume over area of the closed front `faces`, in mean edge lengths.
+fn depth(points: &[P3], faces: &[[u32; 3]]) -> f64 {
+    let (mut vol, mut area, mut edges) = (0.0, 0.0, 0.0);
+    for f in faces {
+        let [a, b, c] = f.map(|i| points[i as usize]);
+        vol += dot(a, cross(b, c)) / 6.0;
+        area += 0.5 * norm(cross(sub(b, a), sub(c, a)));
+        edges += dist(a, b) + dist(b, c) + dist(c, a);
+    }
+    let h = edges / (3 * faces.len()).max(1) as f64;
+    vol.abs() / (area * h).max(1e-300)
+}
 
 /// Recovery rounds of the serial pass's tries. Every smooth surface closes
 /// by the second try (the corpus and the 1e5 bench surfaces, P = 8 to
@@ -249,9 +276,14 @@ pub fn build_ddg<C: Comm>(
     let np = comm.parts();
     let mut st = DdgBuildStats::default();
     let t0 = Instant::now();
+    let first = if depth(points, faces) >= DEEP {
+        DEEP_FIRST_LAYER
+    } else {
+        FIRST_LAYER
+    };
     let point_size: Vec<f64> = parafront_surface::mean_edge_lengths(points, faces)
         .iter()
-        .map(|h| FIRST_LAYER * h)
+        .map(|h| first * h)
         .collect();
     // The field grows from the same surface sizes (§5: the initial sizes
     // times the growth), not from the fine ones: from the fine ones, the
@@ -261,7 +293,7 @@ pub fn build_ddg<C: Comm>(
     let field = move |p: P3| field.size(p);
     let sizes = Sizes {
         field: &field,
-        max_growth: FIRST_LAYER,
+        max_growth: first,
     };
     st.field_seconds = t0.elapsed().as_secs_f64();
     let domain = Aabb::from_points(points.iter());
@@ -309,7 +341,16 @@ pub fn build_ddg<C: Comm>(
         st.pass_seconds.push(t0.elapsed().as_secs_f64());
     }
     let t0 = Instant::now();
-    let (made, _) = serial_pass(&mut parts, comm, sizes, &mut next_gid, &DDG_SERIAL_ROUNDS)?;
+    // What the passes left is closed with the fine mesh's growth: the tall
+    // tets that fill a smooth region can wedge a left-over pocket shut
+    // (fertility at P = 32, the tray).
+    let (made, _) = serial_pass(
+        &mut parts,
+        comm,
+        Sizes::fine(&field),
+        &mut next_gid,
+        &DDG_SERIAL_ROUNDS,
+    )?;
     if debug {
         eprintln!(
             "ddg serial pass: {made} tets, {:.3} s",
@@ -371,6 +412,31 @@ pub fn build_ddg<C: Comm>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use parafront_surface::generate;
+
+    /// A ball of radius r is r / 3 deep; halving its edges doubles the
+    /// depth in edges; a plate is about half its thickness deep. The
+    /// front's normals point in, as `build_ddg` takes them.
+    #[test]
+    fn depth_is_volume_over_area_in_edges() {
+        let inward = |s: &parafront_surface::Surface| -> Vec<[u32; 3]> {
+            s.tris.iter().map(|t| [t[0], t[2], t[1]]).collect()
+        };
+        let h = |s: &parafront_surface::Surface| {
+            let m = parafront_surface::mean_edge_lengths(&s.points, &s.tris);
+            m.iter().sum::<f64>() / m.len() as f64
+        };
+        let a = generate::icosphere([0.0; 3], 2.0, 3);
+        let b = generate::icosphere([0.0; 3], 2.0, 4);
+        let (da, db) = (depth(&a.points, &inward(&a)), depth(&b.points, &inward(&b)));
+        // The area and volume of the polyhedron are a little under the
+        // ball's, the mean edge is per point rather than per edge.
+        assert!((da * h(&a) - 2.0 / 3.0).abs() < 0.05, "{da}");
+        assert!((db / da - 2.0).abs() < 0.05, "{da} {db}");
+        let p = generate::needle_plate(1.0, 8);
+        assert!(depth(&p.points, &inward(&p)) < 1.0);
+        assert!(db < DEEP, "a 1e3-triangle ball keeps the usual first layer");
+    }
 
     #[test]
     fn frames_are_rotations() {

@@ -535,7 +535,7 @@ pub(crate) struct Sizes<'a> {
 
 impl<'a> Sizes<'a> {
     /// The fine mesh's: the front's default growth.
-    fn fine(field: &'a (dyn Fn(P3) -> f64 + Sync)) -> Sizes<'a> {
+    pub(crate) fn fine(field: &'a (dyn Fn(P3) -> f64 + Sync)) -> Sizes<'a> {
         Sizes {
             field,
             max_growth: parafront_front::MAX_GROWTH_PER_TET,
