@@ -391,6 +391,7 @@ impl SeparatingPlanes {
 
     /// `d[i][j]`: how far corner `j` of `g` lies outside face plane `i`.
     #[inline(always)]
+    #[allow(clippy::needless_range_loop)] // the same index into three arrays
     fn outside(&self, g: &[P3; 3]) -> [[f64; 3]; 4] {
         // Loops, not `map`: nested array maps were left out of line.
         let mut d = [[0.0; 3]; 4];
