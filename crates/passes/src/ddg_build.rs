@@ -242,7 +242,7 @@ pub const DEEP_FIRST_LAYER: f64 = 4.0;
 pub const DEEP: f64 = 10.0;
 
 /// Volume over area of the closed front `faces`, in mean edge lengths.
-fn depth(points: &[P3], faces: &[[u32; 3]]) -> f64 {
+pub(crate) fn depth(points: &[P3], faces: &[[u32; 3]]) -> f64 {
     let (mut vol, mut area, mut edges) = (0.0, 0.0, 0.0);
     for f in faces {
         let [a, b, c] = f.map(|i| points[i as usize]);

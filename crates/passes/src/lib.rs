@@ -76,7 +76,20 @@ pub enum PassError {
         100.0 * left
     )]
     Unsuited { left: f64 },
+    /// The region is a thin plate before any pass runs (its volume over
+    /// its area is under [`THIN_DEPTH`] mean surface edges): every such
+    /// part of the corpus left 31-93 % to pass 4, after seconds to minutes.
+    #[error(
+        "a thin part, {depth:.2} surface edges deep (volume over area): the walls between parts would cross most of it"
+    )]
+    Thin { depth: f64 },
 }
+
+/// Depth, in mean surface edges, under which a region skips the passes
+/// ([`PassError::Thin`]). The corpus's thin plates are 0.14-0.35 deep
+/// (the tray, the plate with holes, the hinge, base_interface), every
+/// other input 1.7 or more.
+pub const THIN_DEPTH: f64 = 0.5;
 
 /// What the passes did, for the summary and the benchmark table.
 #[derive(Clone, Debug, Default)]
@@ -313,6 +326,10 @@ pub fn mesh_parallel<C: Comm>(
         parts: np,
         ..Default::default()
     };
+    let depth = ddg_build::depth(points, faces);
+    if depth < thin_depth() {
+        return Err(PassError::Thin { depth });
+    }
     // §5 step 1: the DDG (replicated: it is small).
     let cpu0 = process_cpu_seconds();
     let t_ddg = Instant::now();
@@ -746,6 +763,14 @@ fn left_fraction<C: Comm>(parts: &[Part], comm: &C, points: &[P3], faces: &[[u32
     } else {
         0.0
     }
+}
+
+/// [`THIN_DEPTH`], or `PARAFRONT_THIN_DEPTH` (0: never).
+fn thin_depth() -> f64 {
+    std::env::var("PARAFRONT_THIN_DEPTH")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(THIN_DEPTH)
 }
 
 fn serial_from() -> f64 {

@@ -430,6 +430,7 @@ fn mesh_parts(
             Err(
                 e @ (PassError::Pass { .. }
                 | PassError::Unsuited { .. }
+                | PassError::Thin { .. }
                 | PassError::Ddg(DdgError::Front(_))),
             ) => {
                 tracing::warn!(
