@@ -315,13 +315,13 @@ impl Work<'_> {
             return Err(Outcome::NotBetter);
         }
         let np = PointId::new(self.m.points.len());
-        c.old.clear();
-        c.old.extend_from_slice(&s.best_cav);
-        c.new.clear();
-        c.new.extend(s.best_star.iter().map(|&(mut v, f)| {
-            v[f] = np;
-            v
-        }));
+        c.set(
+            &s.best_cav,
+            s.best_star.iter().map(|&(mut v, f)| {
+                v[f] = np;
+                v
+            }),
+        );
         c.qmin = sc.qmin;
         Ok(pos)
     }
@@ -370,9 +370,7 @@ impl Work<'_> {
             let Some((nt, new)) = self.face_swap(t, f) else {
                 continue;
             };
-            s.cav.clear();
-            s.cav.extend([t, nt]);
-            let old = self.score_old(&s.cav);
+            let old = self.score_old(&[t, nt]);
             let mut sum = 0.0;
             let mut under = 0;
             let mut dmin = f64::INFINITY;
@@ -390,10 +388,7 @@ impl Work<'_> {
             let gain = sum - (1000.0 * old.under as f64 + old.short);
             if ok && under < old.under && dmin >= old.dmin && best.is_none_or(|b| gain < b.0) {
                 best = Some((gain, under, dmin));
-                c.old.clear();
-                c.old.extend([t, nt]);
-                c.new.clear();
-                c.new.extend(new);
+                c.set(&[t, nt], new);
                 found = Outcome::Done;
             }
         }
@@ -402,9 +397,7 @@ impl Work<'_> {
             if self.ring(t, a, b, &mut s.tets, &mut s.ring).is_none() {
                 continue;
             }
-            s.cav.clear();
-            s.cav.extend_from_slice(&s.tets);
-            let old = self.score_old(&s.cav);
+            let old = self.score_old(&s.tets);
             let n = s.ring.len();
             let (pa, pb) = (self.m.points[a.idx()], self.m.points[b.idx()]);
             let r: Vec<P3> = s.ring.iter().map(|p| self.m.points[p.idx()]).collect();
@@ -488,10 +481,7 @@ impl Work<'_> {
                 .fold(f64::INFINITY, f64::min);
             if dmin > old && dmin >= BAD_DEG && dmin > best {
                 best = dmin;
-                c.old.clear();
-                c.old.extend([t, nt]);
-                c.new.clear();
-                c.new.extend(new);
+                c.set(&[t, nt], new);
                 found = Outcome::Done;
             }
         }

@@ -39,6 +39,16 @@ pub(crate) struct Cand {
     pub qmin: f64,
 }
 
+impl Cand {
+    /// The change: tets `old` out, `new` in.
+    pub(crate) fn set(&mut self, old: &[u32], new: impl IntoIterator<Item = [PointId; 4]>) {
+        self.old.clear();
+        self.old.extend_from_slice(old);
+        self.new.clear();
+        self.new.extend(new);
+    }
+}
+
 /// Relative margin a change must beat the old worst quality by, so that
 /// operations never cycle.
 pub(crate) const MARGIN: f64 = 1e-3;
@@ -115,10 +125,7 @@ impl Work<'_> {
         if !self.all_positive(&new) {
             return Outcome::Inverted;
         }
-        c.old.clear();
-        c.old.extend([t, nt]);
-        c.new.clear();
-        c.new.extend(new);
+        c.set(&[t, nt], new);
         c.qmin = qmin;
         Outcome::Done
     }
