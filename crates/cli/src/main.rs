@@ -189,6 +189,15 @@ fn main() -> ExitCode {
         .with_writer(std::io::stderr)
         .init();
     let cli = Cli::parse();
+    // The pool before any parallel work: reading a surface sorts in
+    // parallel, and the first use of rayon fixes the global pool.
+    if let Cmd::Demo { mesh, .. } | Cmd::Mesh { mesh, .. } = &cli.cmd {
+        if let Some(t) = mesh.threads.filter(|&t| t > 0) {
+            let _ = rayon::ThreadPoolBuilder::new()
+                .num_threads(t)
+                .build_global();
+        }
+    }
     let res = match cli.cmd {
         Cmd::Demo {
             output,
@@ -312,12 +321,6 @@ fn run_mesh(s: &Surface, name: &str, out: &Path, a: &MeshArgs, w: &WriteArgs) ->
                 out.display()
             ),
         ));
-    }
-    if opts.threads > 0 {
-        // Only the first call can set the pool; later ones keep it.
-        let _ = rayon::ThreadPoolBuilder::new()
-            .num_threads(opts.threads)
-            .build_global();
     }
     println!(
         "{name}: {} points, {} triangles",
@@ -453,9 +456,11 @@ fn print_summary(sum: &Summary, q: &QualityReport) {
         .map(|(n, s)| format!("{n} {s:.3}"))
         .collect();
     println!(
-        "seconds: {} (total {:.3})",
+        "seconds: {} (total {:.3}, {} thread{})",
         stages.join(", "),
-        sum.total_seconds()
+        sum.total_seconds(),
+        sum.threads,
+        if sum.threads == 1 { "" } else { "s" }
     );
     if front > 0.0 {
         println!("front: {:.0} tets/s", sum.tets as f64 / front);

@@ -118,6 +118,8 @@ pub enum MeshError {
 /// What a run made, for the summary line and the benchmark tables.
 #[derive(Clone, Debug, Default)]
 pub struct Summary {
+    /// Threads the run had (`MeshOptions::threads`, or the pool's).
+    pub threads: usize,
     pub tets: usize,
     pub points: usize,
     pub regions: usize,
@@ -158,9 +160,23 @@ impl Summary {
 
 /// Mesh the volume bounded by `s`. The result keeps the surface triangle
 /// for triangle (its points come first, with their ids) and has passed
-/// `check_against_surface` unless `no_check`.
+/// `check_against_surface` unless `no_check`. Runs on `opts.threads`
+/// threads (a pool of its own when that differs from the current one).
 pub fn mesh_surface(s: &Surface, opts: &MeshOptions) -> Result<(TetMesh, Summary), MeshError> {
-    let mut sum = Summary::default();
+    let t = opts.threads;
+    if t > 0 && t != rayon::current_num_threads() {
+        if let Ok(pool) = rayon::ThreadPoolBuilder::new().num_threads(t).build() {
+            return pool.install(|| mesh_surface_here(s, opts));
+        }
+    }
+    mesh_surface_here(s, opts)
+}
+
+fn mesh_surface_here(s: &Surface, opts: &MeshOptions) -> Result<(TetMesh, Summary), MeshError> {
+    let mut sum = Summary {
+        threads: rayon::current_num_threads(),
+        ..Summary::default()
+    };
     let t0 = Instant::now();
     let mut report = validate(s);
     if !report.is_valid() {

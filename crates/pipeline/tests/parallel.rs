@@ -46,3 +46,23 @@ fn the_demo_part_on_2_and_4_parts() {
         );
     }
 }
+
+#[test]
+fn the_threads_option_is_honoured_and_leaves_the_mesh_alone() {
+    // `MeshOptions::threads` sizes the run's pool (the CLI's --threads);
+    // for fixed parts the mesh is the same on any number of threads.
+    let s = generate::torus([0.0; 3], 2.0, 0.7, 24, 10);
+    let run = |threads: usize| {
+        let o = MeshOptions {
+            threads,
+            ..opts(4, 0.35)
+        };
+        mesh_surface(&s, &o).unwrap()
+    };
+    let (m1, s1) = run(1);
+    let (m3, s3) = run(3);
+    assert_eq!((s1.threads, s3.threads), (1, 3));
+    assert!(m1.tets.len() > 1000, "{} tets", m1.tets.len());
+    assert_eq!(m1.tets, m3.tets);
+    assert_eq!(m1.points, m3.points);
+}
