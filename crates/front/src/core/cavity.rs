@@ -700,7 +700,10 @@ impl<'a> Front<'a> {
             .inflated(cl.point.max(cl.new_point));
         let (mut near_f, mut near_p) = (Vec::new(), Vec::new());
         self.gather(&bb, f, &mut near_f, &mut near_p);
-        self.tet_is_free(v, q, p, &near_f, &near_p, cl)
+        matches!(
+            self.tet_is_free(v, q, p, &near_f, &near_p, cl),
+            Verdict::Free
+        )
     }
 
     /// The first live face of `faces`, then of those made since `before`.

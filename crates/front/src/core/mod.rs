@@ -146,6 +146,15 @@ pub enum FrontError {
     TooManyPoints(usize),
 }
 
+/// AF2.3's answer for one candidate tet.
+enum Verdict {
+    Free,
+    /// Near face `i` (its index in the near list) blocks it.
+    Face(usize),
+    /// A front point lies in it or too close.
+    Point,
+}
+
 enum Outcome {
     Placed,
     Failed,
@@ -1025,9 +1034,16 @@ impl<'a> Front<'a> {
             } else {
                 self.pts[q as usize]
             };
-            if self.tet_is_free(v, q, pq, &near_f, &near_p, cl) {
-                placed = Some((q, pq));
-                break;
+            match self.tet_is_free(v, q, pq, &near_f, &near_p, cl) {
+                Verdict::Free => {
+                    placed = Some((q, pq));
+                    break;
+                }
+                // The face that blocked this candidate likely blocks the
+                // next one too: it is checked first (the verdict does not
+                // depend on the order).
+                Verdict::Face(i) => near_f.swap(0, i),
+                Verdict::Point => {}
             }
         }
         self.near_p = near_p;
@@ -1095,7 +1111,7 @@ impl<'a> Front<'a> {
         near_f: &[Near],
         near_p: &[u32],
         cl: Clearance,
-    ) -> bool {
+    ) -> Verdict {
         let margin = cl.point;
         let tv = [v[0], v[1], v[2], q];
         let tp = [
@@ -1129,7 +1145,7 @@ impl<'a> Front<'a> {
         // The new edges' boxes, grown by the edge clearance: a front edge
         // whose box misses one is farther than that from the edge.
         let ebox: [Aabb; 3] = [0, 1, 2].map(|e| bbox([tp[e], pq]).inflated(em));
-        for nf in near_f {
+        for (at, nf) in near_f.iter().enumerate() {
             if !nf.bb.overlaps(&tb_clear) {
                 continue;
             }
@@ -1146,7 +1162,7 @@ impl<'a> Front<'a> {
                 && box_dist2(&nf.bb, pq) < m_apex * m_apex * (1.0 + 1e-9)
                 && point_triangle_dist2(pq, gp[0], gp[1], gp[2]) < m_apex * m_apex
             {
-                return false;
+                return Verdict::Face(at);
             }
             // Nor may a new edge pass close by a front edge: two edges
             // crossing a hair apart leave a slab between their faces that
@@ -1203,7 +1219,7 @@ impl<'a> Front<'a> {
                             continue;
                         }
                         if segment_segment_dist2(tp[e], pq, x0, x1) < em * em {
-                            return false;
+                            return Verdict::Face(at);
                         }
                     }
                 }
@@ -1224,19 +1240,19 @@ impl<'a> Front<'a> {
                 if shared == 3 {
                     // A matching face must face the other way (AF5).
                     if same_cycle(fvid, g) {
-                        return false;
+                        return Verdict::Face(at);
                     }
                     continue;
                 }
                 if shared == 2 && cl.wedge > 0.0 && thin_wedge(fvid, nfp[i], g, *gp, cl.wedge) {
-                    return false;
+                    return Verdict::Face(at);
                 }
                 if apart || (shared == 0 && !nfb[i].overlaps(&nf.bb)) {
                     continue;
                 }
                 let (fp, gq) = shared_first(fvid, nfp[i], g, *gp);
                 if triangles_intersect(fp, gq, shared) {
-                    return false;
+                    return Verdict::Face(at);
                 }
             }
         }
@@ -1253,17 +1269,17 @@ impl<'a> Front<'a> {
             }
             if margin > 0.0 {
                 if planes.within(x, margin) {
-                    return false;
+                    return Verdict::Point;
                 }
             } else if orient3d(tp[1], tp[2], tp[3], x) < 0.0
                 && orient3d(tp[0], tp[3], tp[2], x) < 0.0
                 && orient3d(tp[0], tp[1], tp[3], x) < 0.0
                 && orient3d(tp[0], tp[2], tp[1], x) < 0.0
             {
-                return false;
+                return Verdict::Point;
             }
         }
-        true
+        Verdict::Free
     }
 
     /// AF3-AF5: add the tet, its new point, and update the front.
