@@ -15,6 +15,7 @@ use std::sync::Mutex;
 /// regular tet at the size `h` at its centroid.
 pub fn tet_weights(d: &Ddg, h: &(dyn Fn(P3) -> f64 + Sync)) -> Vec<f64> {
     (0..d.tets.len())
+        .into_par_iter()
         .map(|t| {
             let p = d.tet_points(t);
             let v = tet_volume6(p[0], p[1], p[2], p[3]) / 6.0;
