@@ -265,7 +265,7 @@ impl Work<'_> {
                 }
             }
         }
-        let Some((mut sc, old, mut pos)) = best else {
+        let Some((sc, old, pos)) = best else {
             return Err(Outcome::Inverted);
         };
         // Compass search on the chosen cavity.
@@ -277,35 +277,21 @@ impl Work<'_> {
                 dist2(q, pos).sqrt()
             })
             .fold(f64::INFINITY, f64::min);
-        let mut step = 0.3 * len;
         // Lifting the worst tet needs a finer search (they are few).
         let (iters, stop) = if lift.is_some() {
             (60, 1e-4)
         } else {
             (20, 1e-2)
         };
-        for _ in 0..iters {
-            if step < stop * len {
-                break;
-            }
-            let mut moved = None;
-            for dir in crate::ops::DIRS {
-                let p = [0, 1, 2].map(|k| pos[k] + step * dir[k]);
-                if let Some(n) = self.score_star(&s.best_star, p) {
-                    let cur = moved.as_ref().map_or(&sc, |m: &(Score, P3)| &m.0);
-                    if less(n.key(&old, lift), cur.key(&old, lift)) {
-                        moved = Some((n, p));
-                    }
-                }
-            }
-            match moved {
-                Some((n, p)) => {
-                    sc = n;
-                    pos = p;
-                }
-                None => step *= 0.5,
-            }
-        }
+        let (sc, pos) = crate::ops::compass(
+            pos,
+            sc,
+            0.3 * len,
+            stop * len,
+            iters,
+            |p, _| self.score_star(&s.best_star, p),
+            |n, cur| less(n.key(&old, lift), cur.key(&old, lift)),
+        );
         let ok = (sc.under < old.under && sc.dmin >= old.dmin)
             || (lift.is_some()
                 && sc.dmin > old.dmin * (1.0 + MARGIN) + 1e-9

@@ -82,6 +82,45 @@ pub(crate) const DIRS: [P3; 14] = [
     [S, -S, -S],
 ];
 
+/// Compass search (§9.4's selective movement): from `pos`, valued
+/// `best`, try a step along each of [`DIRS`] and move to the best one
+/// that `better` prefers, else halve the step; at most `iters` rounds,
+/// until the step is under `stop`. `eval(p, cur)` values `p` given the
+/// best value so far (`None`: not allowed there).
+pub(crate) fn compass<E>(
+    mut pos: P3,
+    mut best: E,
+    mut step: f64,
+    stop: f64,
+    iters: usize,
+    mut eval: impl FnMut(P3, &E) -> Option<E>,
+    better: impl Fn(&E, &E) -> bool,
+) -> (E, P3) {
+    for _ in 0..iters {
+        if step < stop {
+            break;
+        }
+        let mut moved: Option<(E, P3)> = None;
+        for dir in DIRS {
+            let c = [0, 1, 2].map(|k| pos[k] + step * dir[k]);
+            let cur = moved.as_ref().map_or(&best, |m| &m.0);
+            if let Some(e) = eval(c, cur) {
+                if better(&e, cur) {
+                    moved = Some((e, c));
+                }
+            }
+        }
+        match moved {
+            Some((e, c)) => {
+                best = e;
+                pos = c;
+            }
+            None => step *= 0.5,
+        }
+    }
+    (best, pos)
+}
+
 /// How much of the ball's mean mean ratio selective movement may give for
 /// each unit it adds to the ball's worst. Without a limit, selective moves
 /// around the tets under 0.7 pulled skull.obj's mean radius ratio from
@@ -561,31 +600,17 @@ impl Work<'_> {
             s.ball = ball;
             return Outcome::NotBetter;
         };
-        let (mut best, mut pos) = (d0, p0);
-        let mut step = 0.1 * len;
-        for _ in 0..60 {
-            if step < 1e-3 * len {
-                break;
-            }
-            let mut moved = None;
-            for dir in DIRS {
-                let c = [0, 1, 2].map(|k| pos[k] + step * dir[k]);
-                // No more tets under 10° than before: the share under 10°
-                // is the other criterion.
-                if let Some((d, _)) = eval(self, c).filter(|e| e.1 <= under0) {
-                    if d > moved.map_or(best, |m: (f64, P3)| m.0) + 1e-9 {
-                        moved = Some((d, c));
-                    }
-                }
-            }
-            match moved {
-                Some((d, c)) => {
-                    best = d;
-                    pos = c;
-                }
-                None => step *= 0.5,
-            }
-        }
+        // No more tets under 10° than before: the share under 10° is the
+        // issue's other criterion.
+        let (best, pos) = compass(
+            p0,
+            d0,
+            0.1 * len,
+            1e-3 * len,
+            60,
+            |c, _| eval(self, c).filter(|e| e.1 <= under0).map(|e| e.0),
+            |d, cur| *d > *cur + 1e-9,
+        );
         let out = if best > d0 * (1.0 + MARGIN) + 1e-9 {
             self.commit_move(p, pos, &ball);
             Outcome::Done
@@ -641,30 +666,15 @@ impl Work<'_> {
             s.ball = ball;
             return Outcome::NotBetter;
         };
-        let (mut best, mut pos) = (e0, p0);
-        let mut step = 0.3 * len;
-        for _ in 0..20 {
-            if step < 1e-2 * len {
-                break;
-            }
-            let mut moved: Option<((usize, f64, f64), P3)> = None;
-            for dir in DIRS {
-                let c = [0, 1, 2].map(|k| pos[k] + step * dir[k]);
-                let cur = moved.map_or(best, |m| m.0);
-                if let Some(e) = eval(self, c, cur.0, e0.2) {
-                    if better(e, cur) {
-                        moved = Some((e, c));
-                    }
-                }
-            }
-            match moved {
-                Some((e, c)) => {
-                    best = e;
-                    pos = c;
-                }
-                None => step *= 0.5,
-            }
-        }
+        let (best, pos) = compass(
+            p0,
+            e0,
+            0.3 * len,
+            1e-2 * len,
+            20,
+            |c, cur| eval(self, c, cur.0, e0.2),
+            |a, b| better(*a, *b),
+        );
         let out = if best.0 < e0.0 {
             self.commit_move(p, pos, &ball);
             Outcome::Done
