@@ -65,7 +65,7 @@ pub(crate) fn positive(p: [P3; 4]) -> bool {
 
 /// The compass search's directions: the axes and the cube's diagonals.
 const S: f64 = 0.577_350_269_189_625_8;
-pub(crate) const DIRS: [P3; 14] = [
+const DIRS: [P3; 14] = [
     [1.0, 0.0, 0.0],
     [-1.0, 0.0, 0.0],
     [0.0, 1.0, 0.0],

@@ -272,11 +272,24 @@ pub fn build_ddg<C: Comm>(
     passes: usize,
     comm: &C,
 ) -> Result<(Ddg, DdgBuildStats), PassError> {
+    build_ddg_at(points, faces, depth(points, faces), c, passes, comm)
+}
+
+/// [`build_ddg`] for a front `depth` mean edges deep ([`depth`]): the
+/// passes have it already, from their thin-part test.
+pub(crate) fn build_ddg_at<C: Comm>(
+    points: &[P3],
+    faces: &[[u32; 3]],
+    depth: f64,
+    c: f64,
+    passes: usize,
+    comm: &C,
+) -> Result<(Ddg, DdgBuildStats), PassError> {
     let t_all = Instant::now();
     let np = comm.parts();
     let mut st = DdgBuildStats::default();
     let t0 = Instant::now();
-    let first = if depth(points, faces) >= DEEP {
+    let first = if depth >= DEEP {
         DEEP_FIRST_LAYER
     } else {
         FIRST_LAYER

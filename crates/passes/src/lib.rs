@@ -334,7 +334,7 @@ pub fn mesh_parallel<C: Comm>(
     let cpu0 = process_cpu_seconds();
     let t_ddg = Instant::now();
     let built = if opts.ddg_passes > 0 {
-        match build_ddg(points, faces, opts.growth, opts.ddg_passes, comm) {
+        match ddg_build::build_ddg_at(points, faces, depth, opts.growth, opts.ddg_passes, comm) {
             Ok((d, bs)) => {
                 st.ddg_build = Some(bs);
                 Some(d)
@@ -540,11 +540,6 @@ pub fn mesh_parallel<C: Comm>(
     Ok(ParOutput { stats: st, ..out })
 }
 
-/// One parallel pass on partition `part_of`: send each front face to the
-/// part that owns its three points, and a copy to every part whose region
-/// box it meets (so that each part knows every face bounding its region);
-/// every part advances its faces; new points get global ids. Returns the
-/// tets and the front seconds of each part.
 /// How the passes' fronts size new tets: the field, and the tallest tet
 /// over a face, in its longest edges (`FrontOptions::max_growth`).
 #[derive(Clone, Copy)]
@@ -563,6 +558,11 @@ impl<'a> Sizes<'a> {
     }
 }
 
+/// One parallel pass on partition `part_of`: send each front face to the
+/// part that owns its three points, and a copy to every part whose region
+/// box it meets (so that each part knows every face bounding its region);
+/// every part advances its faces; new points get global ids. Returns the
+/// tets and the front seconds of each part.
 fn parallel_pass<C: Comm>(
     parts: &mut [Part],
     comm: &C,

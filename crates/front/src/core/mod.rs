@@ -936,8 +936,9 @@ impl<'a> Front<'a> {
         let nrm = normalize(tri_normal(pa, pb, pc));
         let m = centroid3(pa, pb, pc);
         let emax = dist(pa, pb).max(dist(pb, pc)).max(dist(pc, pa));
-        // A tet at most twice its face: sizes still grow geometrically, and a
-        // small face under a large size (CAD needles) keeps a local search.
+        // A tet at most `max_growth` times its face: sizes still grow
+        // geometrically, and a small face under a large size (CAD needles)
+        // keeps a local search.
         let h = ((self.hp[v[0] as usize] + self.hp[v[1] as usize] + self.hp[v[2] as usize]) / 3.0)
             .min(self.opts.max_growth * emax);
         let dm = (dist(m, pa) + dist(m, pb) + dist(m, pc)) / 3.0;
@@ -951,15 +952,18 @@ impl<'a> Front<'a> {
         // AF2.2: close points and faces, from one box holding every
         // candidate tet.
         // Wider searches on later rounds, but bounded: near lists grow as r^3.
+        let tries = self.fv[fid as usize].tries;
+        // This face's round: its own failures and the front's recovery.
+        let round = tries as u32 + self.relax;
         let relax = self.relax.min(2) as f64;
         let hs = h.min(WIDE_SEARCH * emax);
-        let r = hs.max(emax)
-            * (SEARCH_RADIUS + 0.35 * relax + 0.25 * self.fv[fid as usize].tries as f64);
+        let tall = hs < h;
+        let r = hs.max(emax) * (SEARCH_RADIUS + 0.35 * relax + 0.25 * tries as f64);
         let cq = add(m, scale(nrm, 0.5 * alpha));
         let mut qbox = Aabb { min: cq, max: cq }
             .inflated(r)
             .union(&tri_box(&self.pts, v));
-        if hs < h {
+        if tall {
             qbox = qbox.union(
                 &Aabb {
                     min: pstar,
@@ -986,7 +990,7 @@ impl<'a> Front<'a> {
         // The grid's layout follows from the order of operations alone, so
         // the query order is deterministic without sorting.
         let mut star_clear = true;
-        let too_close = 0.55 * h * if hs < h { TALL_REUSE } else { 1.0 };
+        let too_close = 0.55 * h * if tall { TALL_REUSE } else { 1.0 };
         for &q in &near_p {
             if v.contains(&q) {
                 continue;
@@ -1012,8 +1016,7 @@ impl<'a> Front<'a> {
         // New points: the ideal one, and lower ones once a face has failed
         // (a narrow gap has room for a flat tet only). Id NONE - k codes
         // height k.
-        let tries = self.fv[fid as usize].tries as u32 + self.relax;
-        let heights: &[f64] = if tries == 0 {
+        let heights: &[f64] = if round == 0 {
             &[1.0]
         } else {
             &[1.0, 0.7, 0.45, 0.25]
@@ -1039,7 +1042,7 @@ impl<'a> Front<'a> {
         // Relative to the best this face allows: a needle surface triangle
         // makes no good tet at all, and must not wait for recovery.
         let best = candidate_score(pa, pb, pc, pstar, h).0;
-        let min_score: f64 = match self.relax + self.fv[fid as usize].tries as u32 {
+        let min_score: f64 = match round {
             0 => 0.12f64,
             1 => 0.05,
             2 => 0.01,
@@ -1047,7 +1050,7 @@ impl<'a> Front<'a> {
         }
         .min(0.3 * best);
         // Kept clear of other front points (a fraction of the size).
-        let cl = Clearance::for_round(self.relax + self.fv[fid as usize].tries as u32, h);
+        let cl = Clearance::for_round(round, h);
         let mut placed = None;
         for &(score, q) in &cands {
             let s = if score >= 1.0 { score - 1.0 } else { score };
