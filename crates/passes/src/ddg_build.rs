@@ -254,6 +254,34 @@ pub(crate) fn depth(points: &[P3], faces: &[[u32; 3]]) -> f64 {
     vol.abs() / (area * h).max(1e-300)
 }
 
+/// The DDG's largest size on `parts` parts, as a share of a part's
+/// width (the cube root of its volume). The shifts of passes 2 and 3
+/// move each wall by two layers of DDG tets; where a DDG tet is as wide
+/// as a part, two layers reach every part, and the front that pass 1
+/// leaves there all goes to one part in pass 2 (sphere_5e6 on 16 parts:
+/// 30 % of pass 2 on one).
+fn cap_share() -> f64 {
+    std::env::var("PARAFRONT_DDG_CAP")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(0.2)
+}
+
+/// [`cap_share`] times a part's width: no cap on one part.
+fn size_cap(points: &[P3], faces: &[[u32; 3]], parts: usize) -> f64 {
+    if parts <= 1 {
+        return f64::INFINITY;
+    }
+    let vol: f64 = faces
+        .iter()
+        .map(|f| {
+            let [a, b, c] = f.map(|i| points[i as usize]);
+            dot(a, cross(b, c)) / 6.0
+        })
+        .sum();
+    cap_share() * (vol.abs() / parts as f64).cbrt()
+}
+
 /// Recovery rounds of the serial pass's tries. Every smooth surface closes
 /// by the second try (the corpus and the 1e5 bench surfaces, P = 8 to
 /// 128); what does not is a thin CAD part, where more tries cost minutes
@@ -303,7 +331,8 @@ pub(crate) fn build_ddg_at<C: Comm>(
     // layer over the first one gets it the first one's size again, and the
     // DDG of sphere_5e6 has 429k tets instead of 362k.
     let field = ddg::GradedField::of_sizes(points, &point_size, (c - 1.0).max(0.0));
-    let field = move |p: P3| field.size(p);
+    let cap = size_cap(points, faces, np).max(point_size.iter().cloned().fold(0.0, f64::max));
+    let field = move |p: P3| field.size(p).min(cap);
     let sizes = Sizes {
         field: &field,
         max_growth: first,

@@ -20,7 +20,7 @@ use parafront_ddg::{self as ddg, Ddg, Interfaces, Locator, PartFilter, Shift};
 use parafront_front::{
     advance, Everywhere, FrontError, FrontInput, FrontOptions, RegionFilter, SizeMode,
 };
-use parafront_geom::{tet_volume6, Aabb, P3};
+use parafront_geom::{orient3d, tet_volume6, Aabb, P3};
 use rayon::prelude::*;
 use rustc_hash::FxHashMap;
 use std::time::Instant;
@@ -137,6 +137,8 @@ pub struct ParStats {
     pub part_seconds: Vec<Vec<f64>>,
     /// Passes on a crossing partition after pass 3 (counted in pass 3).
     pub crossing_passes: usize,
+    /// Parts off the surface that pass 1 started from a seed tet.
+    pub seeds: usize,
     pub redistribute_seconds: f64,
 }
 
@@ -388,8 +390,10 @@ pub fn mesh_parallel<C: Comm>(
     st.split_seconds = t_split;
     let t_rcb = t0.elapsed().as_secs_f64();
     st.predicted_imbalance = ddg::imbalance(&part0, &w, np);
-    let part2 = ddg::shifted(&d, &part0, Shift::FromHigher, opts.layers);
-    let part3 = ddg::shifted(&d, &part0, Shift::FromLower, opts.layers);
+    // Passes 2 and 3 shift it once pass 1 has shown where its front is
+    // left (`order_for_shift`).
+    let mut part0 = part0;
+    let (mut part2, mut part3) = (Vec::new(), Vec::new());
     st.partition_seconds = t0.elapsed().as_secs_f64();
     st.partition = opts.partition;
     st.cut_faces = ddg::cut_faces(&d, &part0);
@@ -405,13 +409,13 @@ pub fn mesh_parallel<C: Comm>(
     }
     if std::env::var_os("PARAFRONT_DEBUG_PASSES").is_some() {
         eprintln!(
-            "partition: weights {t_w:.3} s, split {t_split:.3} s (with the locator {t_rcb:.3} s), shifts {:.3} s",
-            st.partition_seconds - t_rcb
+            "partition: weights {t_w:.3} s, split {t_split:.3} s (with the locator {t_rcb:.3} s)"
         );
     }
 
     let mut parts = seed_parts(np, points, point_size, faces);
     let mut next_gid = points.len() as u32;
+    st.seeds = seed_inner_parts(&mut parts, &d, &loc, &part0, size, &mut next_gid);
     let mut made_per_part = vec![0usize; np];
 
     // §7 step 3, passes 1 to 3; then, while the front left would make
@@ -420,6 +424,39 @@ pub fn mesh_parallel<C: Comm>(
     // both shifts meet, inside the crossing parts (P >= 32 on 1M tets).
     let mut crossing: Vec<Vec<u32>> = Vec::new();
     for j in 0..3 + MAX_CROSSING {
+        if j == 1 || j == 4 {
+            // Name the parts so that the next shift shares out what the
+            // pass on the unshifted partition left, then shift it (§7
+            // passes 2 and 3; the crossing partition likewise).
+            let t = Instant::now();
+            let left = front_left_per_tet(&parts, comm, &loc, d.tets.len());
+            let base = if j == 1 { &mut part0 } else { &mut crossing[0] };
+            let label = ddg::order_for_shift(&d, base, &left, opts.layers, np);
+            for k in base.iter_mut() {
+                *k = label[*k as usize];
+            }
+            let up = ddg::shifted(&d, base, Shift::FromHigher, opts.layers);
+            let down = ddg::shifted(&d, base, Shift::FromLower, opts.layers);
+            if std::env::var_os("PARAFRONT_DEBUG_PASSES").is_some() {
+                let loads = ddg::shift_loads(&d, base, &left, opts.layers, np);
+                eprintln!(
+                    "relabelled for pass {}: {:.3} s, front left per part {loads:?}",
+                    j + 1,
+                    t.elapsed().as_secs_f64()
+                );
+            }
+            if j == 1 {
+                let mut made = vec![0; np];
+                for (k, &n) in made_per_part.iter().enumerate() {
+                    made[label[k] as usize] = n;
+                }
+                made_per_part = made;
+                (part2, part3) = (up, down);
+            } else {
+                crossing.extend([up, down]);
+            }
+            st.partition_seconds += t.elapsed().as_secs_f64();
+        }
         let t0 = Instant::now();
         if j >= 3 {
             let left = comm.all_reduce(parts.iter().map(|p| p.front.len()).collect(), |a, b| a + b);
@@ -434,10 +471,7 @@ pub fn mesh_parallel<C: Comm>(
                 Partition::Rcb => Partition::Metis,
                 Partition::Metis => Partition::Rcb,
             };
-            let c = ddg::partition(&d, &w, size, np, method);
-            let c2 = ddg::shifted(&d, &c, Shift::FromHigher, opts.layers);
-            let c3 = ddg::shifted(&d, &c, Shift::FromLower, opts.layers);
-            crossing = vec![c, c2, c3];
+            crossing = vec![ddg::partition(&d, &w, size, np, method)];
             st.partition_seconds += t.elapsed().as_secs_f64();
         }
         let part_of: &[u32] = match j {
@@ -727,6 +761,135 @@ fn front_call(
         stuck,
         seconds: t0.elapsed().as_secs_f64(),
     })
+}
+
+/// Pass 1 for the parts that own no face of the input front (those off
+/// the surface, P >= 32 on a ball): their whole region would wait for
+/// pass 2, on one part. Each gets one fine regular tet, inside-out: at the
+/// middle of its DDG tet farthest (in face steps) from its walls, with its
+/// faces facing out as its front. Returns how many parts got one.
+fn seed_inner_parts(
+    parts: &mut [Part],
+    d: &Ddg,
+    loc: &Locator,
+    part0: &[u32],
+    size: &(dyn Fn(P3) -> f64 + Sync),
+    next_gid: &mut u32,
+) -> usize {
+    let np = parts.len();
+    let nt = d.tets.len();
+    // Face steps from a wall or the surface.
+    let mut depth = vec![u32::MAX; nt];
+    let mut queue = std::collections::VecDeque::new();
+    // Parts that own a face of the input front (held by part 0).
+    let mut owns = vec![false; np];
+    let owner: Vec<Option<u32>> = parts[0]
+        .pts
+        .par_iter()
+        .map(|&p| loc.owner(p, part0))
+        .collect();
+    for f in &parts[0].front {
+        let o = f.map(|i| owner[i as usize]);
+        if let Some(k) = o[0] {
+            if o[1] == o[0] && o[2] == o[0] {
+                owns[k as usize] = true;
+            }
+        }
+    }
+    for t in 0..nt {
+        let wall = (0..4).any(|f| {
+            let n = d.neigh[4 * t + f];
+            n == u32::MAX || part0[(n / 4) as usize] != part0[t]
+        });
+        if wall {
+            depth[t] = 0;
+            queue.push_back(t);
+        }
+    }
+    while let Some(t) = queue.pop_front() {
+        for f in 0..4 {
+            let n = d.neigh[4 * t + f];
+            if n != u32::MAX && depth[(n / 4) as usize] == u32::MAX {
+                depth[(n / 4) as usize] = depth[t] + 1;
+                queue.push_back((n / 4) as usize);
+            }
+        }
+    }
+    // Per part without a face, its tets, deepest first.
+    let mut cands: Vec<Vec<usize>> = vec![Vec::new(); np];
+    for t in 0..nt {
+        if !owns[part0[t] as usize] {
+            cands[part0[t] as usize].push(t);
+        }
+    }
+    // Corners of a regular tet of unit edge about the origin.
+    let s = 1.0 / 8f64.sqrt();
+    let corners = [[s, s, s], [s, -s, -s], [-s, s, -s], [-s, -s, s]];
+    // Its faces, facing out of it (the front's faces face the space left).
+    const OUTWARD: [[usize; 3]; 4] = [[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]];
+    let seed_in = |t: usize| -> Option<[P3; 4]> {
+        let c = d.centroid(t);
+        let h = size(c);
+        let mut v = corners.map(|q| [c[0] + h * q[0], c[1] + h * q[1], c[2] + h * q[2]]);
+        if orient3d(v[0], v[1], v[2], v[3]) < 0.0 {
+            v.swap(2, 3);
+        }
+        let [a, b, cc, dd] = d.tet_points(t);
+        let inside = |p: P3| {
+            orient3d(p, b, cc, dd) > 0.0
+                && orient3d(a, p, cc, dd) > 0.0
+                && orient3d(a, b, p, dd) > 0.0
+                && orient3d(a, b, cc, p) > 0.0
+        };
+        (v.iter().all(|&p| inside(p)) && orient3d(v[0], v[1], v[2], v[3]) > 0.0).then_some(v)
+    };
+    let mut seeded = 0;
+    for (k, mut ts) in cands.into_iter().enumerate() {
+        ts.sort_by_key(|&t| (std::cmp::Reverse(depth[t]), t));
+        let Some(v) = ts.iter().find_map(|&t| seed_in(t)) else {
+            continue;
+        };
+        let part = &mut parts[k];
+        let ids = v.map(|p| {
+            let gid = *next_gid;
+            *next_gid += 1;
+            part.local(Rec { gid, p, h: size(p) })
+        });
+        part.tets.push(ids);
+        part.tet_pass.push(1);
+        for f in OUTWARD {
+            part.front.push(f.map(|i| ids[i]));
+        }
+        seeded += 1;
+    }
+    seeded
+}
+
+/// Per DDG tet, the front faces left in it (the first tet holding each
+/// face's centroid), summed over the parts.
+fn front_left_per_tet<C: Comm>(parts: &[Part], comm: &C, loc: &Locator, n_tets: usize) -> Vec<u32> {
+    let local: Vec<Vec<u32>> = parts
+        .par_iter()
+        .map(|part| {
+            let mut ts = Vec::with_capacity(part.front.len());
+            for f in &part.front {
+                let v = f.map(|i| part.pts[i as usize]);
+                let c = [0, 1, 2].map(|i| (v[0][i] + v[1][i] + v[2][i]) / 3.0);
+                loc.hosts(c, |t| {
+                    ts.push(t);
+                    false
+                });
+            }
+            ts
+        })
+        .collect();
+    let mut left = vec![0u32; n_tets];
+    for ts in comm.all_gather(local) {
+        for t in ts {
+            left[t as usize] += 1;
+        }
+    }
+    left
 }
 
 /// Crossing passes after pass 3: one on a partition by the other method,

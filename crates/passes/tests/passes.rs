@@ -317,3 +317,30 @@ fn crossing_passes_on_many_parts() {
     assert_eq!(st.part_seconds.len(), 3 + st.crossing_passes);
     assert!(share < 0.05, "pass 4 made {:.1}%", 100.0 * share);
 }
+
+/// Parts that own no face of the surface (inner parts of a ball on many
+/// parts) start pass 1 from a seed tet instead of waiting for pass 2, so
+/// every part works in pass 1; the mesh stays valid.
+#[test]
+fn inner_parts_start_from_a_seed() {
+    let s = generate::icosphere([0.0; 3], 1.0, 4);
+    let h = 0.07;
+    let o = run(&s, h, 32);
+    check(&s, &o);
+    let st = &o.stats;
+    let n = o.tets.len() as f64;
+    eprintln!(
+        "P=32: {} tets, {} seeds, per pass {:?}, pass-1 seconds {:?}",
+        o.tets.len(),
+        st.seeds,
+        st.pass_tets,
+        st.part_seconds[0]
+    );
+    assert!(st.seeds > 0, "no part off the surface");
+    assert!(
+        st.part_seconds[0].iter().all(|&x| x > 0.0),
+        "a part idle in pass 1"
+    );
+    assert!(st.pass_tets[0] as f64 > 0.5 * n);
+    assert!((st.pass_tets[3] as f64) < 0.01 * n);
+}
