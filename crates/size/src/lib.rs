@@ -114,7 +114,7 @@ impl Sizing {
 
         let growth = if opts.surface_growth && !surface.tris.is_empty() {
             let seeds = surface_seeds(surface, &patch_sizes, hmin, cap)?;
-            Some(SurfaceGrowth::new(&seeds, opts.gradation - 1.0))
+            Some(SurfaceGrowth::with_cap(&seeds, opts.gradation - 1.0, cap))
         } else {
             None
         };

@@ -459,3 +459,39 @@ fn no_growth_is_the_smallest_surface_size() {
     assert!((sz.size([0.0; 3]) - hmin).abs() < 1e-12);
     assert!((sz.size([5.0, 0.0, 0.0]) - hmin).abs() < 1e-12);
 }
+
+/// A capped growth is `min(f, cap)` to the octree's tolerances, and drops
+/// what the cap hides: the seeds at the cap and the cells above it.
+#[test]
+fn a_capped_growth_is_the_capped_field_and_smaller() {
+    let s = torus(60, 24, 0.8, 0.3);
+    let h = s.mean_edge_lengths();
+    let seeds: Vec<([f64; 3], f64)> = s.points.iter().copied().zip(h.iter().copied()).collect();
+    let hmean = h.iter().sum::<f64>() / h.len() as f64;
+    let c = 0.3;
+    let full = SurfaceGrowth::new(&seeds, c);
+    for cap in [0.9 * hmean, 1.5 * hmean, 4.0 * hmean] {
+        let capped = SurfaceGrowth::with_cap(&seeds, c, cap);
+        assert!(capped.stats().nodes <= full.stats().nodes);
+        if cap < hmean {
+            assert!(capped.stats().seeds < seeds.len());
+            assert!(capped.stats().nodes < full.stats().nodes / 4);
+        }
+        for i in 0..2000 {
+            // Points in and around the torus, deterministic.
+            let t = i as f64 * 0.618_034;
+            let p = [
+                1.3 * (t * 1.7).sin(),
+                1.3 * (t * 2.3).cos(),
+                0.5 * (t * 3.1).sin(),
+            ];
+            let e = exact(&seeds, c, p).min(cap);
+            let v = capped.size(p);
+            assert!(
+                v <= cap && v <= e * 1.03 && v >= e * 0.8,
+                "cap {cap}, at {p:?}: {v} vs {e}"
+            );
+            assert_eq!(capped.exact(p), e);
+        }
+    }
+}
