@@ -331,7 +331,13 @@ pub(crate) fn build_ddg_at<C: Comm>(
     // layer over the first one gets it the first one's size again, and the
     // DDG of sphere_5e6 has 429k tets instead of 362k.
     let field = ddg::GradedField::of_sizes(points, &point_size, (c - 1.0).max(0.0));
-    let cap = size_cap(points, faces, np).max(point_size.iter().cloned().fold(0.0, f64::max));
+    // Only deep fronts grow DDG tets as wide as a part; on shallow ones a
+    // cap at the first layer's size costs tets (spot on 32 parts: +1.3 %).
+    let cap = if depth >= DEEP {
+        size_cap(points, faces, np).max(point_size.iter().cloned().fold(0.0, f64::max))
+    } else {
+        f64::INFINITY
+    };
     let field = move |p: P3| field.size(p).min(cap);
     let sizes = Sizes {
         field: &field,

@@ -342,5 +342,6 @@ fn inner_parts_start_from_a_seed() {
         "a part idle in pass 1"
     );
     assert!(st.pass_tets[0] as f64 > 0.5 * n);
-    assert!((st.pass_tets[3] as f64) < 0.01 * n);
+    // 32 parts of 4k tets: pass 4 takes about 1 %.
+    assert!((st.pass_tets[3] as f64) < 0.03 * n);
 }
