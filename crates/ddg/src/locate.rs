@@ -184,7 +184,7 @@ impl Locator {
 
     /// Whether `p` lies strictly inside tet `t`: then `t` is its only host.
     #[inline]
-    fn strictly_holds(&self, t: u32, p: P3) -> bool {
+    pub fn strictly_holds(&self, t: u32, p: P3) -> bool {
         let [a, b, c, d] = self.tets[t as usize];
         orient3d(p, b, c, d) > 0.0
             && orient3d(a, p, c, d) > 0.0

@@ -180,9 +180,9 @@ impl Near {
     }
 }
 
-/// New labels for the parts of `part` (old label to new), so that the pass on its shift by `layers`
-/// (§7, pass 2: a part takes the DDG layers of its neighbours of higher
-/// index) shares out the front that the pass before it left: `left[t]`
+/// New labels for the parts of `part` (old label to new), so that the
+/// pass on its shift by `layers` (§7, pass 2: a part takes the DDG layers
+/// of its neighbours of higher index) shares out the front that the pass before it left: `left[t]`
 /// faces in DDG tet `t`. Such a face goes to the lowest part within
 /// `layers` of its tet, so a part's load is what lies near it and no part
 /// labelled before it. Labelling next, again and again, the part that

@@ -20,7 +20,7 @@ use parafront_ddg::{self as ddg, Ddg, Interfaces, Locator, PartFilter, Shift};
 use parafront_front::{
     advance, Everywhere, FrontError, FrontInput, FrontOptions, RegionFilter, SizeMode,
 };
-use parafront_geom::{orient3d, tet_volume6, Aabb, P3};
+use parafront_geom::{centroid3, orient3d, tet_volume6, Aabb, P3};
 use rayon::prelude::*;
 use rustc_hash::FxHashMap;
 use std::time::Instant;
@@ -424,6 +424,22 @@ pub fn mesh_parallel<C: Comm>(
     // both shifts meet, inside the crossing parts (P >= 32 on 1M tets).
     let mut crossing: Vec<Vec<u32>> = Vec::new();
     for j in 0..3 + MAX_CROSSING {
+        if j >= 3 {
+            let left = comm.all_reduce(parts.iter().map(|p| p.front.len()).collect(), |a, b| a + b);
+            let made: usize = st.pass_tets.iter().sum();
+            if (left as f64) < CROSSING_FROM * made as f64 {
+                break;
+            }
+        }
+        if j == 3 {
+            let t = Instant::now();
+            let method = match opts.partition {
+                Partition::Rcb => Partition::Metis,
+                Partition::Metis => Partition::Rcb,
+            };
+            crossing = vec![ddg::partition(&d, &w, size, np, method)];
+            st.partition_seconds += t.elapsed().as_secs_f64();
+        }
         if j == 1 || j == 4 {
             // Name the parts so that the next shift shares out what the
             // pass on the unshifted partition left, then shift it (§7
@@ -457,23 +473,8 @@ pub fn mesh_parallel<C: Comm>(
             }
             st.partition_seconds += t.elapsed().as_secs_f64();
         }
+        // Partition work above counts in `partition_seconds`, not here.
         let t0 = Instant::now();
-        if j >= 3 {
-            let left = comm.all_reduce(parts.iter().map(|p| p.front.len()).collect(), |a, b| a + b);
-            let made: usize = st.pass_tets.iter().sum();
-            if (left as f64) < CROSSING_FROM * made as f64 {
-                break;
-            }
-        }
-        if j == 3 {
-            let t = Instant::now();
-            let method = match opts.partition {
-                Partition::Rcb => Partition::Metis,
-                Partition::Metis => Partition::Rcb,
-            };
-            crossing = vec![ddg::partition(&d, &w, size, np, method)];
-            st.partition_seconds += t.elapsed().as_secs_f64();
-        }
         let part_of: &[u32] = match j {
             0 => &part0,
             1 => &part2,
@@ -834,14 +835,9 @@ fn seed_inner_parts(
         if orient3d(v[0], v[1], v[2], v[3]) < 0.0 {
             v.swap(2, 3);
         }
-        let [a, b, cc, dd] = d.tet_points(t);
-        let inside = |p: P3| {
-            orient3d(p, b, cc, dd) > 0.0
-                && orient3d(a, p, cc, dd) > 0.0
-                && orient3d(a, b, p, dd) > 0.0
-                && orient3d(a, b, cc, p) > 0.0
-        };
-        (v.iter().all(|&p| inside(p)) && orient3d(v[0], v[1], v[2], v[3]) > 0.0).then_some(v)
+        (v.iter().all(|&p| loc.strictly_holds(t as u32, p))
+            && orient3d(v[0], v[1], v[2], v[3]) > 0.0)
+            .then_some(v)
     };
     let mut seeded = 0;
     for (k, mut ts) in cands.into_iter().enumerate() {
@@ -873,9 +869,8 @@ fn front_left_per_tet<C: Comm>(parts: &[Part], comm: &C, loc: &Locator, n_tets: 
         .map(|part| {
             let mut ts = Vec::with_capacity(part.front.len());
             for f in &part.front {
-                let v = f.map(|i| part.pts[i as usize]);
-                let c = [0, 1, 2].map(|i| (v[0][i] + v[1][i] + v[2][i]) / 3.0);
-                loc.hosts(c, |t| {
+                let [a, b, c] = f.map(|i| part.pts[i as usize]);
+                loc.hosts(centroid3(a, b, c), |t| {
                     ts.push(t);
                     false
                 });
