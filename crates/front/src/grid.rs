@@ -222,9 +222,10 @@ impl LooseGrid {
     pub fn query(&self, q: &Aabb, mut f: impl FnMut(u32, [u32; 3])) {
         let (qlo, qhi) = self.rel(q);
         let qk = lanes(qhi, qlo, f32::INFINITY);
+        // Once per query: zeroing it per cell was 2 % of the front's time.
+        let mut buf = [(0u32, [0u32; 3]); 64];
         let mut scan = |cell: &[Entry]| {
             // Branch-free: a branch per entry was often mispredicted.
-            let mut buf = [(0u32, [0u32; 3]); 64];
             for chunk in cell.chunks(64) {
                 let mut n = 0;
                 for e in chunk {

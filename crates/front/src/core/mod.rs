@@ -488,6 +488,15 @@ impl SeparatingPlanes {
     }
 }
 
+/// The L1 length of the box around `a` and `b`: a bound on the distance
+/// between any two of their points.
+#[inline]
+fn span1(a: &Aabb, b: &Aabb) -> f64 {
+    (0..3)
+        .map(|k| a.max[k].max(b.max[k]) - a.min[k].min(b.min[k]))
+        .sum()
+}
+
 #[inline]
 fn heap_entry(key: f64, face: u32) -> u64 {
     ((key as f32).to_bits() as u64) << 32 | face as u64
@@ -1205,6 +1214,12 @@ impl<'a> Front<'a> {
             let mut clear = false;
             for di in &d {
                 clear |= (di[0] > em) & (di[1] > em) & (di[2] > em);
+            }
+            // Then `g` has no corner on the tet, and `separates` would find
+            // that plane: its rounding bound, 3e-12 of the distance between
+            // the two (under the boxes' span), is far below `em`.
+            if clear && em > 3e-12 * span1(&tb, &nf.bb) {
+                continue;
             }
             if em > 0.0 && !clear {
                 // Front edge k against new edge e = (tv[e], q), by the tet's
