@@ -528,9 +528,8 @@ impl<'a> Front<'a> {
             let Some(top) = stack.last_mut() else {
                 return false;
             };
-            let fid = *self
-                .fmap
-                .get(&sorted3(top.face))
+            let fid = self
+                .face_id(top.face)
                 .expect("a pocket face is in the front");
             let mut placed = false;
             while top.next < top.cands.len() && left > 0 {
@@ -541,7 +540,7 @@ impl<'a> Front<'a> {
                 if self.apex_free(fid, q, p, Clearance::EXACT) {
                     let before = self.fv.len() as u32;
                     top.tet = self.tets.len() as u32;
-                    self.commit(fid, q, p);
+                    self.commit(fid, q, p, &[]);
                     self.refresh(&mut faces, before);
                     placed = true;
                     break;
@@ -724,9 +723,9 @@ impl<'a> Front<'a> {
 
     fn commit_cone(&mut self, pocket: &[u32], p: P3) {
         let id = self.pts.len() as u32;
-        self.commit(pocket[0], NONE, p);
+        self.commit(pocket[0], NONE, p, &[]);
         for &f in &pocket[1..] {
-            self.commit(f, id, p);
+            self.commit(f, id, p, &[]);
         }
         self.stats.pockets_filled += 1;
     }
@@ -771,7 +770,7 @@ mod tests {
             .filter(|&t| f.talive[t])
             .map(|t| f.tets[t])
             .collect();
-        assert!(f.fmap.is_empty(), "{} faces left", f.fmap.len());
+        assert_eq!(f.n_front, 0, "faces left");
         // A face as a cycle starting at its smallest corner: a face and its
         // turned copy differ.
         let cycle = |v: [u32; 3]| {
@@ -873,7 +872,7 @@ mod tests {
         let pocket = f.pocket(0);
         assert_eq!(pocket.len(), 8);
         assert!(!f.close_by_existing(&pocket, EXHAUSTIVE_BUDGET));
-        assert_eq!(f.fmap.len(), 8, "the failed search undoes its tets");
+        assert_eq!(f.n_front, 8, "the failed search undoes its tets");
         let pocket = f.pocket(f.first_alive(&pocket, 0).unwrap());
         assert!(f.fill_by_kernel(&pocket));
         assert_eq!(assert_fills(&f, &faces, vol), 8);

@@ -194,6 +194,7 @@ struct Face {
 #[derive(Clone, Copy)]
 struct Near {
     v: [u32; 3],
+    id: u32,
     bb: Aabb,
     /// Its corners: gather loads them anyway, and each candidate tet
     /// would load them again from all over `pts`.
@@ -206,7 +207,12 @@ struct Front<'a> {
     n_input: usize,
     /// Every face ever made, by id (dead ones too: ids stay put).
     fv: Vec<Face>,
-    fmap: FxHashMap<[u32; 3], u32>,
+    /// Live faces by their sorted corners, built when recovery first needs
+    /// it: AF5 finds a new tet's matching faces among AF2's near faces, so
+    /// the front itself keeps no map (a hash update or two per face made).
+    fmap: Option<FxHashMap<[u32; 3], u32>>,
+    /// Live faces.
+    n_front: usize,
     /// AF1's queue: `key << 32 | face`, the key an `f32` size (positive
     /// floats order as their bits), so one entry is 8 bytes.
     heap: MinQueue,
@@ -577,7 +583,8 @@ impl<'a> Front<'a> {
             hp: input.point_size,
             n_input: n,
             fv: Vec::new(),
-            fmap: FxHashMap::default(),
+            fmap: None,
+            n_front: 0,
             heap: MinQueue::default(),
             fgrid: LooseGrid::new(s0, bb.min),
             tets: Vec::new(),
@@ -658,7 +665,10 @@ impl<'a> Front<'a> {
             tries: 0,
             alive: true,
         });
-        self.fmap.insert(sorted3(v), id);
+        if let Some(m) = &mut self.fmap {
+            m.insert(sorted3(v), id);
+        }
+        self.n_front += 1;
         self.fgrid.insert(id, v, &tri_box(&self.pts, v));
         let key = self.face_key(v);
         self.heap.push(heap_entry(key, id));
@@ -669,7 +679,10 @@ impl<'a> Front<'a> {
         debug_assert!(self.fv[i].alive);
         self.fv[i].alive = false;
         let v = self.fv[i].v;
-        self.fmap.remove(&sorted3(v));
+        if let Some(m) = &mut self.fmap {
+            m.remove(&sorted3(v));
+        }
+        self.n_front -= 1;
         self.fgrid.remove(id, &tri_box(&self.pts, v));
     }
 
@@ -701,7 +714,7 @@ impl<'a> Front<'a> {
                 }
             }
             if g != skip {
-                near_f.push(Near { v: w, bb, p })
+                near_f.push(Near { v: w, id: g, bb, p })
             }
         });
         self.stamp = stamp;
@@ -892,8 +905,8 @@ impl<'a> Front<'a> {
                 }
                 continue;
             }
-            match self.fmap.get(&sorted3(w)) {
-                Some(&g) if self.fv[g as usize].owner == fr => self.remove_face(g),
+            match self.face_id(w) {
+                Some(g) if self.fv[g as usize].owner == fr => self.remove_face(g),
                 found => {
                     // An input face: it faces the hole again.
                     debug_assert!(found.is_none(), "face {w:?} twice in the front");
@@ -1091,7 +1104,9 @@ impl<'a> Front<'a> {
         self.cands = cands;
         match placed {
             Some((q, pq)) => {
-                self.commit(fid, q, pq);
+                let near_f = std::mem::take(&mut self.near_f);
+                self.commit(fid, q, pq, &near_f);
+                self.near_f = near_f;
                 Outcome::Placed
             }
             None => Outcome::Failed,
@@ -1328,8 +1343,23 @@ impl<'a> Front<'a> {
         Verdict::Free
     }
 
-    /// AF3-AF5: add the tet, its new point, and update the front.
-    fn commit(&mut self, fid: u32, q: u32, pq: P3) {
+    /// The live face with corners `w` (any order), from the map, built
+    /// on the first call.
+    fn face_id(&mut self, w: [u32; 3]) -> Option<u32> {
+        let fv = &self.fv;
+        let m = self.fmap.get_or_insert_with(|| {
+            (0..fv.len() as u32)
+                .filter(|&f| fv[f as usize].alive)
+                .map(|f| (sorted3(fv[f as usize].v), f))
+                .collect()
+        });
+        m.get(&sorted3(w)).copied()
+    }
+
+    /// AF3-AF5: add the tet, its new point, and update the front. `near`
+    /// holds every live face within the tet's box (AF2's near faces) or is
+    /// empty, and then the map is asked.
+    fn commit(&mut self, fid: u32, q: u32, pq: P3, near: &[Near]) {
         let v = self.fv[fid as usize].v;
         let q = if is_new_point(q) {
             let id = self.pts.len() as u32;
@@ -1356,7 +1386,13 @@ impl<'a> Front<'a> {
         for i in 0..3 {
             let w = TET_FACES[i].map(|k| tv[k]);
             let fr = 4 * t + i as u32;
-            if let Some(&g) = self.fmap.get(&sorted3(w)) {
+            let key = sorted3(w);
+            let found = if near.is_empty() || self.fmap.is_some() {
+                self.face_id(w)
+            } else {
+                near.iter().find(|nf| sorted3(nf.v) == key).map(|nf| nf.id)
+            };
+            if let Some(g) = found {
                 let o = self.fv[g as usize].owner;
                 self.neigh[fr as usize] = o;
                 if o != NONE {
@@ -1371,7 +1407,7 @@ impl<'a> Front<'a> {
             if let Some(p) = &self.opts.progress {
                 p.set(
                     self.stats.tets as u64,
-                    self.fmap.len() as u64,
+                    self.n_front as u64,
                     self.relax as u64,
                 );
             }
