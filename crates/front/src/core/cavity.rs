@@ -540,7 +540,7 @@ impl<'a> Front<'a> {
                 if self.apex_free(fid, q, p, Clearance::EXACT) {
                     let before = self.fv.len() as u32;
                     top.tet = self.tets.len() as u32;
-                    self.commit(fid, q, p, &[]);
+                    self.commit(fid, q, p, None);
                     self.refresh(&mut faces, before);
                     placed = true;
                     break;
@@ -723,9 +723,9 @@ impl<'a> Front<'a> {
 
     fn commit_cone(&mut self, pocket: &[u32], p: P3) {
         let id = self.pts.len() as u32;
-        self.commit(pocket[0], NONE, p, &[]);
+        self.commit(pocket[0], NONE, p, None);
         for &f in &pocket[1..] {
-            self.commit(f, id, p, &[]);
+            self.commit(f, id, p, None);
         }
         self.stats.pockets_filled += 1;
     }

@@ -1099,18 +1099,17 @@ impl<'a> Front<'a> {
                 Verdict::Point => {}
             }
         }
-        self.near_p = near_p;
-        self.near_f = near_f;
-        self.cands = cands;
-        match placed {
+        let outcome = match placed {
             Some((q, pq)) => {
-                let near_f = std::mem::take(&mut self.near_f);
-                self.commit(fid, q, pq, &near_f);
-                self.near_f = near_f;
+                self.commit(fid, q, pq, Some(&near_f));
                 Outcome::Placed
             }
             None => Outcome::Failed,
-        }
+        };
+        self.near_p = near_p;
+        self.near_f = near_f;
+        self.cands = cands;
+        outcome
     }
 
     /// Distance along the ray `m + t n` to the first front face it meets,
@@ -1356,10 +1355,11 @@ impl<'a> Front<'a> {
         m.get(&sorted3(w)).copied()
     }
 
-    /// AF3-AF5: add the tet, its new point, and update the front. `near`
-    /// holds every live face within the tet's box (AF2's near faces) or is
-    /// empty, and then the map is asked.
-    fn commit(&mut self, fid: u32, q: u32, pq: P3, near: &[Near]) {
+    /// AF3-AF5: add the tet, its new point, and update the front. `near`,
+    /// when given, holds every live face within the tet's box (AF2's near
+    /// faces); without it, or once recovery has built the map, the map is
+    /// asked.
+    fn commit(&mut self, fid: u32, q: u32, pq: P3, near: Option<&[Near]>) {
         let v = self.fv[fid as usize].v;
         let q = if is_new_point(q) {
             let id = self.pts.len() as u32;
@@ -1386,11 +1386,12 @@ impl<'a> Front<'a> {
         for i in 0..3 {
             let w = TET_FACES[i].map(|k| tv[k]);
             let fr = 4 * t + i as u32;
-            let key = sorted3(w);
-            let found = if near.is_empty() || self.fmap.is_some() {
-                self.face_id(w)
-            } else {
-                near.iter().find(|nf| sorted3(nf.v) == key).map(|nf| nf.id)
+            let found = match near {
+                Some(near) if self.fmap.is_none() => {
+                    let key = sorted3(w);
+                    near.iter().find(|nf| sorted3(nf.v) == key).map(|nf| nf.id)
+                }
+                _ => self.face_id(w),
             };
             if let Some(g) = found {
                 let o = self.fv[g as usize].owner;
