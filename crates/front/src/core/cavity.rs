@@ -701,7 +701,7 @@ impl<'a> Front<'a> {
         self.gather(&bb, f, &mut near_f, &mut near_p);
         matches!(
             self.tet_is_free(v, q, p, &near_f, &near_p, cl),
-            Verdict::Free
+            Verdict::Free(_)
         )
     }
 

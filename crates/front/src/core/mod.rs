@@ -166,7 +166,9 @@ pub enum FrontError {
 
 /// AF2.3's answer for one candidate tet.
 enum Verdict {
-    Free,
+    /// Free; with, per new face `i` (`TET_FACES[i]`), the near face it
+    /// matches (AF5), or `NONE`.
+    Free([u32; 3]),
     /// Near face `i` (its index in the near list) blocks it.
     Face(usize),
     /// A front point lies in it or too close.
@@ -1088,8 +1090,8 @@ impl<'a> Front<'a> {
                 self.pts[q as usize]
             };
             match self.tet_is_free(v, q, pq, &near_f, &near_p, cl) {
-                Verdict::Free => {
-                    placed = Some((q, pq));
+                Verdict::Free(matched) => {
+                    placed = Some((q, pq, matched));
                     break;
                 }
                 // The face that blocked this candidate likely blocks the
@@ -1100,8 +1102,8 @@ impl<'a> Front<'a> {
             }
         }
         let outcome = match placed {
-            Some((q, pq)) => {
-                self.commit(fid, q, pq, Some(&near_f));
+            Some((q, pq, matched)) => {
+                self.commit(fid, q, pq, Some(matched));
                 Outcome::Placed
             }
             None => Outcome::Failed,
@@ -1199,6 +1201,9 @@ impl<'a> Front<'a> {
         // The new edges' boxes, grown by the edge clearance: a front edge
         // whose box misses one is farther than that from the edge.
         let ebox: [Aabb; 3] = [0, 1, 2].map(|e| bbox([tp[e], pq]).inflated(em));
+        // Every face on three tet corners reaches the test below: no filter
+        // before it skips a face that touches the tet.
+        let mut matched = [NONE; 3];
         for (at, nf) in near_f.iter().enumerate() {
             if !nf.bb.overlaps(&tb_clear) {
                 continue;
@@ -1302,6 +1307,9 @@ impl<'a> Front<'a> {
                     if same_cycle(fvid, g) {
                         return Verdict::Face(at);
                     }
+                    if matched[i] == NONE {
+                        matched[i] = nf.id;
+                    }
                     continue;
                 }
                 if shared == 2 && cl.wedge > 0.0 && thin_wedge(fvid, nfp[i], g, *gp, cl.wedge) {
@@ -1339,7 +1347,7 @@ impl<'a> Front<'a> {
                 return Verdict::Point;
             }
         }
-        Verdict::Free
+        Verdict::Free(matched)
     }
 
     /// The live face with corners `w` (any order), from the map, built
@@ -1355,11 +1363,12 @@ impl<'a> Front<'a> {
         m.get(&sorted3(w)).copied()
     }
 
-    /// AF3-AF5: add the tet, its new point, and update the front. `near`,
-    /// when given, holds every live face within the tet's box (AF2's near
-    /// faces); without it, or once recovery has built the map, the map is
+    /// AF3-AF5: add the tet, its new point, and update the front.
+    /// `matched`, when given, is `tet_is_free`'s match of each new face
+    /// among AF2's near faces, which hold every live face within the tet's
+    /// box; without it, or once recovery has built the map, the map is
     /// asked.
-    fn commit(&mut self, fid: u32, q: u32, pq: P3, near: Option<&[Near]>) {
+    fn commit(&mut self, fid: u32, q: u32, pq: P3, matched: Option<[u32; 3]>) {
         let v = self.fv[fid as usize].v;
         let q = if is_new_point(q) {
             let id = self.pts.len() as u32;
@@ -1386,11 +1395,8 @@ impl<'a> Front<'a> {
         for i in 0..3 {
             let w = TET_FACES[i].map(|k| tv[k]);
             let fr = 4 * t + i as u32;
-            let found = match near {
-                Some(near) if self.fmap.is_none() => {
-                    let key = sorted3(w);
-                    near.iter().find(|nf| sorted3(nf.v) == key).map(|nf| nf.id)
-                }
+            let found = match matched {
+                Some(m) if self.fmap.is_none() => (m[i] != NONE).then_some(m[i]),
                 _ => self.face_id(w),
             };
             if let Some(g) = found {
