@@ -41,6 +41,15 @@ impl Aabb {
     pub fn overlaps(&self, o: &Aabb) -> bool {
         (0..3).all(|k| self.min[k] <= o.max[k] && o.min[k] <= self.max[k])
     }
+    /// `overlaps` without a branch: for scans whose answers mix.
+    #[inline(always)]
+    pub fn overlaps_nb(&self, o: &Aabb) -> bool {
+        let mut r = true;
+        for k in 0..3 {
+            r &= (self.min[k] <= o.max[k]) & (o.min[k] <= self.max[k]);
+        }
+        r
+    }
     #[inline]
     pub fn contains(&self, p: P3) -> bool {
         (0..3).all(|k| self.min[k] <= p[k] && p[k] <= self.max[k])

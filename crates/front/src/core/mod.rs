@@ -203,6 +203,53 @@ struct Near {
     p: [P3; 3],
 }
 
+/// The indices of the near faces whose boxes meet `b`, in order. The box
+/// tests of 64 faces are done first, without branches: about half pass,
+/// and a branch per face was mispredicted that often.
+struct Overlapping<'n> {
+    near: &'n [Near],
+    b: Aabb,
+    base: usize,
+    next: usize,
+    mask: u64,
+}
+
+impl<'n> Overlapping<'n> {
+    #[inline]
+    fn new(near: &'n [Near], b: Aabb) -> Self {
+        Overlapping {
+            near,
+            b,
+            base: 0,
+            next: 0,
+            mask: 0,
+        }
+    }
+}
+
+impl Iterator for Overlapping<'_> {
+    type Item = usize;
+    #[inline]
+    fn next(&mut self) -> Option<usize> {
+        while self.mask == 0 {
+            if self.next >= self.near.len() {
+                return None;
+            }
+            let end = (self.next + 64).min(self.near.len());
+            let mut m = 0u64;
+            for (j, nf) in self.near[self.next..end].iter().enumerate() {
+                m |= (nf.bb.overlaps_nb(&self.b) as u64) << j;
+            }
+            self.base = self.next;
+            self.next = end;
+            self.mask = m;
+        }
+        let j = self.mask.trailing_zeros() as usize;
+        self.mask &= self.mask - 1;
+        Some(self.base + j)
+    }
+}
+
 struct Front<'a> {
     pts: Vec<P3>,
     hp: Vec<f64>,
@@ -1121,11 +1168,8 @@ impl<'a> Front<'a> {
         let end = add(m, scale(n, limit));
         let mut rb = Aabb { min: m, max: m };
         rb.grow(end);
-        for nf in near_f {
-            if !nf.bb.overlaps(&rb) {
-                continue;
-            }
-            let g = nf.p;
+        for i in Overlapping::new(near_f, rb) {
+            let g = near_f[i].p;
             // Nothing on or under the plane through m is ahead of the ray:
             // the base face's neighbours, most of what passes the box.
             if g.iter().all(|&x| dot(sub(x, m), n) <= 0.0) {
@@ -1204,10 +1248,8 @@ impl<'a> Front<'a> {
         // Every face on three tet corners reaches the test below: no filter
         // before it skips a face that touches the tet.
         let mut matched = [NONE; 3];
-        for (at, nf) in near_f.iter().enumerate() {
-            if !nf.bb.overlaps(&tb_clear) {
-                continue;
-            }
+        for at in Overlapping::new(near_f, tb_clear) {
+            let nf = &near_f[at];
             let g = nf.v;
             let gp = &nf.p;
             let gl = local_ids(g, tv);
