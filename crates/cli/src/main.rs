@@ -344,8 +344,8 @@ fn run_mesh(s: &Surface, name: &str, out: &Path, a: &MeshArgs, w: &WriteArgs) ->
     let t0 = Instant::now();
     write_mesh(out, &mesh, &wopts)?;
     sum.stages.push(("write", t0.elapsed().as_secs_f64()));
-    let q = parafront_pipeline::quality_report(&mesh, s, &opts);
-    print_summary(&sum, &q);
+    let q = &sum.quality;
+    print_summary(&sum, q);
     parallel::print_parallel(&sum);
     println!("wrote {}", out.display());
     if let Some(p) = &a.pvtu {
@@ -353,7 +353,7 @@ fn run_mesh(s: &Surface, name: &str, out: &Path, a: &MeshArgs, w: &WriteArgs) ->
         println!("wrote {} ({} pieces)", p.display(), sum.pieces.len());
     }
     if let Some(p) = &a.plot {
-        plot::plot_histograms(&q, sum.quality_before.as_ref(), p)?;
+        plot::plot_histograms(q, sum.quality_before.as_ref(), p)?;
         println!("wrote {}", p.display());
     }
     Ok(())

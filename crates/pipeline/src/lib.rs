@@ -136,6 +136,9 @@ pub struct Summary {
     pub serial_fallback: Vec<(usize, String)>,
     /// Quality of the front's mesh before improvement (when it ran).
     pub quality_before: Option<QualityReport>,
+    /// Quality of the mesh returned, with edge lengths against the run's
+    /// size field.
+    pub quality: QualityReport,
     /// What improvement did, per operation (when it ran).
     pub improve: Option<parafront_improve::ImproveStats>,
     /// Per region, what the parallel passes did (empty with one part).
@@ -270,6 +273,11 @@ fn mesh_surface_here(s: &Surface, opts: &MeshOptions) -> Result<(TetMesh, Summar
         }
     }
     sum.stages.push(("check", t0.elapsed().as_secs_f64()));
+    // With the run's size field: building it again for the report took
+    // as long as the size field stage.
+    let t0 = Instant::now();
+    sum.quality = QualityReport::with_size(&mesh, |p| sizing.size(p));
+    sum.stages.push(("quality", t0.elapsed().as_secs_f64()));
     sum.tets = mesh.tets.len();
     sum.points = mesh.points.len();
     sum.regions = fronts.len();
@@ -524,12 +532,6 @@ type ParallelMesher = fn(
 
 /// Quality of `mesh` with edge lengths measured against the size field
 /// the run used.
-pub fn quality_report(mesh: &TetMesh, s: &Surface, opts: &MeshOptions) -> QualityReport {
-    match Sizing::build(s, &opts.size, None) {
-        Ok(sz) => QualityReport::with_size(mesh, |p| sz.size(p)),
-        Err(_) => QualityReport::new(mesh),
-    }
-}
 
 #[cfg(test)]
 mod tests {

@@ -29,6 +29,16 @@ fn mesh_with(s: &Surface, o: &MeshOptions) -> parafront_mesh::TetMesh {
     // by close input faces may go lower; these smooth inputs have none.)
     let q = QualityReport::new(&m);
     assert_eq!(q.n_inverted, 0);
+    // The summary's report is of this mesh, with edge lengths against the
+    // run's size field: most edges within a factor two of it.
+    let sq = &summary.quality;
+    assert_eq!(sq.n_tets, m.tets.len());
+    assert_eq!(sq.min_dihedral.min, q.min_dihedral.min);
+    assert_eq!(sq.n_inverted, 0);
+    let er = sq
+        .edge_ratio
+        .expect("the run's size field gives edge ratios");
+    assert!(er.mean > 0.5 && er.mean < 2.0, "mean edge/size {}", er.mean);
     assert!(
         q.mean_ratio.min >= 1.9e-3,
         "min mean ratio {}",
