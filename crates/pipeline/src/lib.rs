@@ -530,9 +530,6 @@ type ParallelMesher = fn(
     &parafront_comm::Threads,
 ) -> Result<ParOutput, PassError>;
 
-/// Quality of `mesh` with edge lengths measured against the size field
-/// the run used.
-
 #[cfg(test)]
 mod tests {
     use super::*;
