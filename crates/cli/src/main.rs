@@ -183,6 +183,15 @@ impl<E: std::fmt::Display> From<E> for Fail {
 }
 
 fn main() -> ExitCode {
+    #[cfg(unix)]
+    // SAFETY: at startup, before any other thread exists. Rust ignores
+    // SIGPIPE, so printing to a pipe whose reader has gone (`| head`)
+    // panicked; the default action ends the process quietly, as for any
+    // Unix tool. Meshes go to files (written aside, then renamed), never
+    // to a pipe.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
     // Diagnostics on stderr, off unless RUST_LOG asks (e.g. RUST_LOG=debug).
     tracing_subscriber::fmt()
         .with_env_filter(tracing_subscriber::EnvFilter::from_default_env())

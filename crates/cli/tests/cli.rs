@@ -57,6 +57,33 @@ fn check_rejects_an_open_surface_with_exit_1() {
     assert!(text.contains("open"), "{text}");
 }
 
+/// A reader that stops early (`parafront check X | head -1`) ends the
+/// run without a panic.
+#[cfg(unix)]
+#[test]
+fn a_closed_stdout_pipe_is_no_panic() {
+    use std::process::Stdio;
+    let out = tmp("pipe_demo.msh");
+    bin()
+        .args(["demo", "--check-only", "-o"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    let mut child = bin()
+        .arg("check")
+        .arg(&out)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // Close the read end before the child writes its report.
+    drop(child.stdout.take());
+    let o = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!err.contains("panicked"), "{err}");
+    assert_ne!(o.status.code(), Some(101), "{err}");
+}
+
 #[test]
 fn unreadable_input_gives_exit_2_and_names_the_line() {
     let f = tmp("bad.obj");
