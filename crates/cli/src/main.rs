@@ -347,7 +347,17 @@ fn run_mesh(s: &Surface, name: &str, out: &Path, a: &MeshArgs, w: &WriteArgs) ->
             if let (Some(path), MeshError::Front { source, .. }) = (&a.debug_dump, &e) {
                 write_partial(path, source, &wopts);
             }
-            return Err(Fail(1, format!("{name}: {e}")));
+            let hint = match (&e, &a.debug_dump) {
+                (
+                    MeshError::Front {
+                        source: parafront_front::FrontError::Stuck { .. },
+                        ..
+                    },
+                    None,
+                ) => "\n(add --debug-dump STUCK.vtu to write what the front made and the faces it left, for ParaView)",
+                _ => "",
+            };
+            return Err(Fail(1, format!("{name}: {e}{hint}")));
         }
     };
     let t0 = Instant::now();
