@@ -363,15 +363,14 @@ fn run_mesh(s: &Surface, name: &str, out: &Path, a: &MeshArgs, w: &WriteArgs) ->
     let t0 = Instant::now();
     write_mesh(out, &mesh, &wopts)?;
     sum.stages.push(("write", t0.elapsed().as_secs_f64()));
-    let q = &sum.quality;
-    print_summary(&sum, q);
+    print_summary(&sum);
     parallel::print_parallel(&sum);
     println!("wrote {}", out.display());
     if let Some(p) = &a.pvtu {
         parallel::write_partitioned(p, &sum, &wopts)?;
         println!("wrote {} ({} pieces)", p.display(), sum.pieces.len());
     }
-    if let Some(p) = &a.plot {
+    if let (Some(p), Some(q)) = (&a.plot, &sum.quality) {
         plot::plot_histograms(q, sum.quality_before.as_ref(), p)?;
         println!("wrote {}", p.display());
     }
@@ -460,7 +459,7 @@ impl ProgressLine {
     }
 }
 
-fn print_summary(sum: &Summary, q: &QualityReport) {
+fn print_summary(sum: &Summary) {
     let front = sum.seconds("front");
     println!(
         "{} tets, {} points, {} region{}",
@@ -540,12 +539,14 @@ fn print_summary(sum: &Summary, q: &QualityReport) {
             st.points_inserted
         );
     }
-    println!(
-        "quality: min dihedral {:.2} deg, {:.3}% of tets under 10 deg, mean radius ratio {:.3}",
-        q.min_dihedral.min,
-        100.0 * q.share_min_dihedral_below,
-        q.radius_ratio.mean
-    );
+    if let Some(q) = &sum.quality {
+        println!(
+            "quality: min dihedral {:.2} deg, {:.3}% of tets under 10 deg, mean radius ratio {:.3}",
+            q.min_dihedral.min,
+            100.0 * q.share_min_dihedral_below,
+            q.radius_ratio.mean
+        );
+    }
 }
 
 /// Peak resident memory (VmHWM) on Linux.

@@ -195,6 +195,7 @@ pub fn run_bench(
                     parts: p.max(1),
                     threads: t,
                     optimize: 0,
+                    no_quality: true,
                     partition: method,
                     ddg_passes,
                     ..Default::default()

@@ -332,13 +332,6 @@ impl Acc {
     }
 }
 
-/// The report of a mesh without tets.
-impl Default for QualityReport {
-    fn default() -> Self {
-        QualityReport::new(&TetMesh::default())
-    }
-}
-
 impl QualityReport {
     /// Shape quality of every tet (no edge-length measure).
     pub fn new(mesh: &TetMesh) -> QualityReport {

@@ -49,6 +49,10 @@ pub struct MeshOptions {
     /// Skip the final validity check (not recommended; it is cheap).
     #[serde(default)]
     pub no_check: bool,
+    /// Skip the quality report (`Summary::quality`): `parafront bench`
+    /// times the meshing alone.
+    #[serde(default)]
+    pub no_quality: bool,
     /// When the front fails, keep its partial mesh and stuck faces in the
     /// error, for a debug dump (`parafront mesh --debug-dump`).
     #[serde(default)]
@@ -86,6 +90,7 @@ impl Default for MeshOptions {
             partition: parafront_ddg::Partition::default(),
             ddg_passes: None,
             no_check: false,
+            no_quality: false,
             debug_partial: false,
             progress: None,
             optimize: default_optimize(),
@@ -137,8 +142,8 @@ pub struct Summary {
     /// Quality of the front's mesh before improvement (when it ran).
     pub quality_before: Option<QualityReport>,
     /// Quality of the mesh returned, with edge lengths against the run's
-    /// size field.
-    pub quality: QualityReport,
+    /// size field (unless `MeshOptions::no_quality`).
+    pub quality: Option<QualityReport>,
     /// What improvement did, per operation (when it ran).
     pub improve: Option<parafront_improve::ImproveStats>,
     /// Per region, what the parallel passes did (empty with one part).
@@ -273,11 +278,13 @@ fn mesh_surface_here(s: &Surface, opts: &MeshOptions) -> Result<(TetMesh, Summar
         }
     }
     sum.stages.push(("check", t0.elapsed().as_secs_f64()));
-    // With the run's size field: building it again for the report took
-    // as long as the size field stage.
-    let t0 = Instant::now();
-    sum.quality = QualityReport::with_size(&mesh, |p| sizing.size(p));
-    sum.stages.push(("quality", t0.elapsed().as_secs_f64()));
+    if !opts.no_quality {
+        // With the run's size field: building it again for the report took
+        // as long as the size field stage.
+        let t0 = Instant::now();
+        sum.quality = Some(QualityReport::with_size(&mesh, |p| sizing.size(p)));
+        sum.stages.push(("quality", t0.elapsed().as_secs_f64()));
+    }
     sum.tets = mesh.tets.len();
     sum.points = mesh.points.len();
     sum.regions = fronts.len();

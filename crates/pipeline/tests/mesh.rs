@@ -31,7 +31,10 @@ fn mesh_with(s: &Surface, o: &MeshOptions) -> parafront_mesh::TetMesh {
     assert_eq!(q.n_inverted, 0);
     // The summary's report is of this mesh, with edge lengths against the
     // run's size field: most edges within a factor two of it.
-    let sq = &summary.quality;
+    let sq = summary
+        .quality
+        .as_ref()
+        .expect("the summary has a quality report");
     assert_eq!(sq.n_tets, m.tets.len());
     assert_eq!(sq.min_dihedral.min, q.min_dihedral.min);
     assert_eq!(sq.n_inverted, 0);
@@ -167,4 +170,21 @@ fn thin_plates_skip_the_passes() {
     m.check_against_surface(&ball.tris).unwrap();
     assert!(summary.serial_fallback.is_empty());
     assert_eq!(summary.parallel.len(), 1);
+}
+
+/// `no_quality` (the benchmarks) leaves the report out, and its time too;
+/// the mesh is the same.
+#[test]
+fn no_quality_skips_the_report_only() {
+    let s = generate::icosphere([0.0; 3], 1.0, 2);
+    let (m0, s0) = mesh_surface(&s, &MeshOptions::default()).unwrap();
+    let o = MeshOptions {
+        no_quality: true,
+        ..MeshOptions::default()
+    };
+    let (m1, s1) = mesh_surface(&s, &o).unwrap();
+    assert!(s0.quality.is_some() && s0.seconds("quality") > 0.0);
+    assert!(s1.quality.is_none());
+    assert!(s1.stages.iter().all(|st| st.0 != "quality"));
+    assert_eq!(m0.tets, m1.tets);
 }
