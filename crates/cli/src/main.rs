@@ -439,6 +439,9 @@ impl ProgressLine {
                 if p.rounds() > 0 {
                     msg.push_str(&format!(", recovery round {}", p.rounds()));
                 }
+                if p.fills() > 0 {
+                    msg.push_str(&format!(", constrained fill {}", p.fills()));
+                }
                 bar.set_message(msg);
                 bar.tick();
                 std::thread::sleep(std::time::Duration::from_millis(100));
@@ -507,6 +510,14 @@ fn print_summary(sum: &Summary) {
         println!(
             "recovery: {} rounds, {} tets removed and re-meshed",
             sum.recovery_rounds, sum.tets_removed
+        );
+    }
+    if sum.cavities_filled > 0 {
+        println!(
+            "constrained fill: {} cavit{} the front could not close, {} tets",
+            sum.cavities_filled,
+            if sum.cavities_filled == 1 { "y" } else { "ies" },
+            sum.fill_tets
         );
     }
     if let Some(m) = peak_memory_bytes() {

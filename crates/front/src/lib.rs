@@ -28,6 +28,7 @@ pub struct Progress {
     tets: AtomicU64,
     front: AtomicU64,
     rounds: AtomicU64,
+    fills: AtomicU64,
 }
 
 impl Progress {
@@ -42,6 +43,13 @@ impl Progress {
     /// Recovery rounds so far.
     pub fn rounds(&self) -> u64 {
         self.rounds.load(Ordering::Relaxed)
+    }
+    /// Constrained fills started so far (issue 20).
+    pub fn fills(&self) -> u64 {
+        self.fills.load(Ordering::Relaxed)
+    }
+    pub(crate) fn note_fill(&self) {
+        self.fills.fetch_add(1, Ordering::Relaxed);
     }
     pub(crate) fn set(&self, tets: u64, front: u64, rounds: u64) {
         self.tets.store(tets, Ordering::Relaxed);

@@ -132,6 +132,10 @@ pub struct Summary {
     pub stages: Vec<(&'static str, f64)>,
     pub recovery_rounds: u32,
     pub tets_removed: usize,
+    /// Cavities a stalled front handed to the constrained Delaunay fill,
+    /// and the tets the fill made (issue 20).
+    pub cavities_filled: usize,
+    pub fill_tets: usize,
     /// Shells (ids as `parafront check` prints them) oriented as inner
     /// bodies and meshed as voids, without `regions`.
     pub voided_shells: Vec<usize>,
@@ -374,6 +378,8 @@ fn serial_region(
     append_region(mesh, rf, &res.points, &res.tets);
     sum.recovery_rounds += res.stats.recovery_rounds;
     sum.tets_removed += res.stats.tets_removed;
+    sum.cavities_filled += res.stats.cavities_filled;
+    sum.fill_tets += res.stats.fill_tets;
     Ok(())
 }
 

@@ -12,6 +12,7 @@ use parafront_mesh::TET_FACES;
 use rustc_hash::FxHashMap;
 
 mod cavity;
+mod fill;
 
 /// Smallest mean ratio the front accepts: a flatter tet may be positive
 /// only in exact arithmetic, and a solver reads it as inverted.
@@ -82,6 +83,17 @@ pub struct FrontOptions {
     /// edge: sizes then grow geometrically, and a small face under a large
     /// size (CAD needles) keeps a local search. The DDG allows more.
     pub max_growth: f64,
+    /// Hand a stalled front's cavities to the constrained Delaunay fill
+    /// (issue 20) instead of failing. Off, the front stops with
+    /// `FrontError::Stuck` where the fill would start.
+    pub fill: bool,
+    /// Recovery rounds without fewer stuck faces before the fill starts.
+    pub fill_stall_rounds: u32,
+    /// Recovery rounds after which the fill starts in any case.
+    pub fill_after_rounds: u32,
+    /// Times a cavity the fill cannot close is grown by the tets behind
+    /// its faces before the front gives up.
+    pub fill_growth: u32,
 }
 
 impl Default for FrontOptions {
@@ -95,6 +107,10 @@ impl Default for FrontOptions {
             pass: false,
             keep_partial: false,
             max_growth: MAX_GROWTH_PER_TET,
+            fill: true,
+            fill_stall_rounds: 3,
+            fill_after_rounds: 12,
+            fill_growth: 8,
         }
     }
 }
@@ -117,6 +133,9 @@ pub struct FrontStats {
     pub tets_removed: usize,
     /// Pockets closed by coning to an inner point (recovery's last resort).
     pub pockets_filled: usize,
+    /// Cavities closed by the constrained Delaunay fill, and its tets.
+    pub cavities_filled: usize,
+    pub fill_tets: usize,
 }
 
 /// What the front made.
@@ -815,37 +834,52 @@ impl<'a> Front<'a> {
                 fewest_stuck = self.stuck.len();
                 last_gain = self.relax;
             }
-            if self.relax >= self.opts.recovery_rounds || self.relax >= last_gain + STALL_ROUNDS {
-                let f = self.stuck[0];
-                let v = self.fv[f as usize].v;
-                let c = centroid3(
-                    self.pts[v[0] as usize],
-                    self.pts[v[1] as usize],
-                    self.pts[v[2] as usize],
-                );
-                let partial = self.opts.keep_partial.then(|| {
-                    Box::new(Partial {
-                        points: self.pts.clone(),
-                        tets: (0..self.tets.len())
-                            .filter(|&t| self.talive[t])
-                            .map(|t| self.tets[t])
-                            .collect(),
-                        front: (0..self.fv.len())
-                            .filter(|&f| self.fv[f].alive)
-                            .map(|f| self.fv[f].v)
-                            .collect(),
-                    })
-                });
-                return Err(FrontError::Stuck {
-                    rounds: self.relax,
-                    faces: self.stuck.len(),
-                    x: c[0],
-                    y: c[1],
-                    z: c[2],
-                    partial,
-                });
+            let give_up =
+                self.relax >= self.opts.recovery_rounds || self.relax >= last_gain + STALL_ROUNDS;
+            let stalled = self.relax >= last_gain + self.opts.fill_stall_rounds
+                || self.relax >= self.opts.fill_after_rounds;
+            if self.opts.fill && (give_up || stalled) {
+                if self.fill_stalled() {
+                    continue;
+                }
+                return Err(self.stuck_error());
+            }
+            if give_up {
+                return Err(self.stuck_error());
             }
             self.recover();
+        }
+    }
+
+    /// The error for a front that cannot be closed, at its first stuck face.
+    fn stuck_error(&self) -> FrontError {
+        let f = self.stuck[0];
+        let v = self.fv[f as usize].v;
+        let c = centroid3(
+            self.pts[v[0] as usize],
+            self.pts[v[1] as usize],
+            self.pts[v[2] as usize],
+        );
+        let partial = self.opts.keep_partial.then(|| {
+            Box::new(Partial {
+                points: self.pts.clone(),
+                tets: (0..self.tets.len())
+                    .filter(|&t| self.talive[t])
+                    .map(|t| self.tets[t])
+                    .collect(),
+                front: (0..self.fv.len())
+                    .filter(|&f| self.fv[f].alive)
+                    .map(|f| self.fv[f].v)
+                    .collect(),
+            })
+        });
+        FrontError::Stuck {
+            rounds: self.relax,
+            faces: self.stuck.len(),
+            x: c[0],
+            y: c[1],
+            z: c[2],
+            partial,
         }
     }
 

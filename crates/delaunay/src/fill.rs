@@ -1,0 +1,407 @@
+//! The constrained fill of a closed cavity (issue 20): the Delaunay
+//! tetrahedralization of its points, its faces recovered by flips, Steiner
+//! points strictly inside it where flips cannot, the tets outside removed.
+//! A star-shaped cavity the recovery cannot close takes the cone from its
+//! kernel's deepest point instead. Every result is verified exactly.
+use crate::flips::key3;
+use crate::recover::recover_all;
+use crate::tri::{InsertError, Triangulation, NONE, TET_FACES};
+use parafront_geom::{centroid3, kernel::deepest_point, orient3d, tri_normal, P3};
+use rustc_hash::{FxHashMap, FxHashSet};
+
+/// Bounds on the fill's work.
+#[derive(Clone, Debug)]
+pub struct FillOptions {
+    /// Steiner points the recovery may add inside the cavity.
+    pub max_steiner: usize,
+    /// Flips tried on one missing face before it counts as stuck.
+    pub flips_per_face: usize,
+}
+
+impl Default for FillOptions {
+    fn default() -> Self {
+        FillOptions {
+            max_steiner: 64,
+            flips_per_face: 64,
+        }
+    }
+}
+
+/// How a cavity was closed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FillMethod {
+    /// Constrained Delaunay: the triangulation of its points (and of any
+    /// Steiner points) with every face recovered.
+    Delaunay,
+    /// Cones from one interior point that sees every face.
+    Cone,
+}
+
+/// A cavity's fill.
+#[derive(Debug, Clone)]
+pub struct Fill {
+    /// Points added strictly inside the cavity.
+    pub steiner: Vec<P3>,
+    /// Positive tets. Ids below `points.len()` are the caller's points;
+    /// id `points.len() + k` is `steiner[k]`.
+    pub tets: Vec<[u32; 4]>,
+    pub method: FillMethod,
+    /// Flips the recovery made.
+    pub flips: usize,
+}
+
+/// Why a cavity was not filled.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum FillError {
+    #[error("the cavity has no faces")]
+    Empty,
+    #[error("cavity face {0} names point {1}, which does not exist")]
+    BadIndex(usize, u32),
+    #[error("cavity face {0} repeats a corner")]
+    Degenerate(usize),
+    #[error("cavity edge {0}-{1} is not shared by exactly two faces of opposite directions")]
+    NotClosed(u32, u32),
+    #[error("the cavity's faces enclose no positive volume")]
+    NotPositive,
+    #[error(transparent)]
+    Insert(#[from] InsertError),
+    #[error(
+        "{missing} of {faces} cavity faces could not be recovered, and no point sees them all"
+    )]
+    Unrecovered { missing: usize, faces: usize },
+}
+
+/// Fill the cavity bounded by `faces` (triangles of `points`, each with its
+/// right-hand normal pointing into the cavity, as a front's faces): tets
+/// whose boundary is exactly `faces`, each positive, with new points only
+/// strictly inside the cavity.
+pub fn fill_cavity(
+    points: &[P3],
+    faces: &[[u32; 3]],
+    opts: &FillOptions,
+) -> Result<Fill, FillError> {
+    validate(points, faces)?;
+    let mut local: Vec<u32> = faces.iter().flatten().copied().collect();
+    local.sort_unstable();
+    local.dedup();
+    let lp: Vec<P3> = local.iter().map(|&i| points[i as usize]).collect();
+    let to_tri: FxHashMap<u32, u32> = local
+        .iter()
+        .enumerate()
+        .map(|(k, &i)| (i, 4 + k as u32))
+        .collect();
+    let cf: Vec<[u32; 3]> = faces.iter().map(|f| f.map(|v| to_tri[&v])).collect();
+    let mut tri = Triangulation::new(&lp)?;
+    let mut flips = 0;
+    let mut steiner: Vec<u32> = Vec::new();
+    let mut tried_cone = false;
+    loop {
+        let missing = recover_all(&mut tri, &cf, opts.flips_per_face, &mut flips);
+        if missing.is_empty() {
+            if let Some(kept) = classify(&tri, &cf) {
+                return Ok(output(
+                    &tri,
+                    &kept,
+                    &local,
+                    points.len(),
+                    FillMethod::Delaunay,
+                    flips,
+                ));
+            }
+        }
+        if std::env::var("DBG_FILL").is_ok() {
+            for &m in &missing {
+                let f = cf[m];
+                eprintln!("missing {:?} {:?}", f, f.map(|v| tri.pts[v as usize]));
+            }
+        }
+        // Flips are stuck: a star-shaped cavity takes the cone.
+        if !tried_cone {
+            tried_cone = true;
+            if let Some(f) = cone(points, faces) {
+                return Ok(f);
+            }
+        }
+        if steiner.len() >= opts.max_steiner || missing.is_empty() {
+            return Err(FillError::Unrecovered {
+                missing: missing.len().max(1),
+                faces: faces.len(),
+            });
+        }
+        // Steiner points near the stuck faces, each strictly inside the
+        // cavity and seeing the faces around it.
+        let mut added = false;
+        for &m in missing.iter().take(4) {
+            if steiner.len() >= opts.max_steiner {
+                break;
+            }
+            if let Some(q) = steiner_near(&tri, &cf, m) {
+                if let Ok(id) = tri.insert(q) {
+                    steiner.push(id);
+                    added = true;
+                }
+            }
+        }
+        if !added {
+            return Err(FillError::Unrecovered {
+                missing: missing.len(),
+                faces: faces.len(),
+            });
+        }
+    }
+}
+
+/// Closed, consistently oriented, non-degenerate, positive volume.
+fn validate(points: &[P3], faces: &[[u32; 3]]) -> Result<(), FillError> {
+    if faces.is_empty() {
+        return Err(FillError::Empty);
+    }
+    let mut half: FxHashMap<(u32, u32), i32> = FxHashMap::default();
+    for (i, f) in faces.iter().enumerate() {
+        if let Some(&v) = f.iter().find(|&&v| v as usize >= points.len()) {
+            return Err(FillError::BadIndex(i, v));
+        }
+        if f[0] == f[1] || f[1] == f[2] || f[0] == f[2] {
+            return Err(FillError::Degenerate(i));
+        }
+        for k in 0..3 {
+            let (a, b) = (f[k], f[(k + 1) % 3]);
+            *half.entry((a, b)).or_default() += 1;
+        }
+    }
+    for (&(a, b), &n) in &half {
+        if n != 1 || half.get(&(b, a)) != Some(&1) {
+            return Err(FillError::NotClosed(a.min(b), a.max(b)));
+        }
+    }
+    let o = points[faces[0][0] as usize];
+    let vol: f64 = faces
+        .iter()
+        .map(|f| {
+            let p = f.map(|v| points[v as usize]);
+            orient3d(p[0], p[1], p[2], o)
+        })
+        .sum();
+    if !(vol > 0.0) {
+        return Err(FillError::NotPositive);
+    }
+    Ok(())
+}
+
+/// The tets inside the recovered faces, grown from each face's inner side
+/// without crossing a face; `None` unless they are bounded by exactly the
+/// faces, each once and from its inner side, and hold no bounding corner.
+fn classify(tri: &Triangulation, cf: &[[u32; 3]]) -> Option<Vec<u32>> {
+    let oriented: FxHashMap<[u32; 3], [u32; 3]> = cf.iter().map(|&f| (key3(f), f)).collect();
+    let mut inside = vec![false; tri.tet_slots()];
+    let mut queue = Vec::new();
+    for &f in cf {
+        let fr = tri.find_face(f)?;
+        let (t, k) = (fr >> 2, (fr & 3) as usize);
+        let p = f.map(|v| tri.pts[v as usize]);
+        let apex = tri.tet(t)[k];
+        let seed = if orient3d(p[0], p[1], p[2], tri.pts[apex as usize]) > 0.0 {
+            t
+        } else {
+            let nb = tri.neighbour(t, k);
+            if nb == NONE {
+                return None;
+            }
+            nb >> 2
+        };
+        if !inside[seed as usize] {
+            inside[seed as usize] = true;
+            queue.push(seed);
+        }
+    }
+    let mut i = 0;
+    while i < queue.len() {
+        let t = queue[i];
+        i += 1;
+        let tv = tri.tet(t);
+        if tv.iter().any(|&v| tri.is_bounding(v)) {
+            return None;
+        }
+        for k in 0..4 {
+            let w = TET_FACES[k].map(|j| tv[j]);
+            if oriented.contains_key(&key3(w)) {
+                continue;
+            }
+            let nb = tri.neighbour(t, k);
+            if nb == NONE {
+                return None;
+            }
+            let u = nb >> 2;
+            if !inside[u as usize] {
+                inside[u as usize] = true;
+                queue.push(u);
+            }
+        }
+    }
+    // Exactly the faces bound the kept tets, each seen from inside.
+    let mut seen: FxHashSet<[u32; 3]> = FxHashSet::default();
+    for &t in &queue {
+        let tv = tri.tet(t);
+        for k in 0..4 {
+            let nb = tri.neighbour(t, k);
+            if nb != NONE && inside[(nb >> 2) as usize] {
+                continue;
+            }
+            let w = TET_FACES[k].map(|j| tv[j]);
+            let f = *oriented.get(&key3(w))?;
+            // The tet's outward face is the cavity face reversed.
+            let r = [f[0], f[2], f[1]];
+            let same = (0..3).any(|s| [r[s], r[(s + 1) % 3], r[(s + 2) % 3]] == w);
+            if !same || !seen.insert(key3(w)) {
+                return None;
+            }
+        }
+    }
+    (seen.len() == cf.len()).then_some(queue)
+}
+
+fn output(
+    tri: &Triangulation,
+    kept: &[u32],
+    local: &[u32],
+    n: usize,
+    method: FillMethod,
+    flips: usize,
+) -> Fill {
+    let nl = local.len() as u32;
+    let mut steiner = Vec::new();
+    let mut sid: FxHashMap<u32, u32> = FxHashMap::default();
+    let mut sorted = kept.to_vec();
+    sorted.sort_unstable();
+    let tets = sorted
+        .iter()
+        .map(|&t| {
+            tri.tet(t).map(|v| {
+                let k = v - 4;
+                if k < nl {
+                    local[k as usize]
+                } else {
+                    *sid.entry(v).or_insert_with(|| {
+                        steiner.push(tri.pts[v as usize]);
+                        (n + steiner.len() - 1) as u32
+                    })
+                }
+            })
+        })
+        .collect();
+    Fill {
+        steiner,
+        tets,
+        method,
+        flips,
+    }
+}
+
+/// The cone from the kernel's deepest point, verified exactly.
+fn cone(points: &[P3], faces: &[[u32; 3]]) -> Option<Fill> {
+    let planes: Vec<(P3, P3)> = faces
+        .iter()
+        .map(|f| {
+            let p = f.map(|v| points[v as usize]);
+            (centroid3(p[0], p[1], p[2]), tri_normal(p[0], p[1], p[2]))
+        })
+        .collect();
+    let (q, depth) = deepest_point(&planes)?;
+    if !(depth > 0.0) || !q.iter().all(|x| x.is_finite()) {
+        return None;
+    }
+    let sees = faces.iter().all(|f| {
+        let p = f.map(|v| points[v as usize]);
+        orient3d(p[0], p[1], p[2], q) > 0.0
+    });
+    if !sees {
+        return None;
+    }
+    let id = points.len() as u32;
+    Some(Fill {
+        steiner: vec![q],
+        tets: faces.iter().map(|f| [f[0], f[1], f[2], id]).collect(),
+        method: FillMethod::Cone,
+        flips: 0,
+    })
+}
+
+/// A point strictly inside the cavity that sees the faces around stuck
+/// face `m` (those sharing a corner with it): their kernel's deepest point
+/// within a box about the face, accepted when it sees each of them and no
+/// cavity face separates it from face `m`'s centroid.
+fn steiner_near(tri: &Triangulation, cf: &[[u32; 3]], m: usize) -> Option<P3> {
+    let f = cf[m];
+    let near: Vec<usize> = (0..cf.len())
+        .filter(|&i| cf[i].iter().any(|v| f.contains(v)))
+        .collect();
+    let pt = |v: u32| tri.pts[v as usize];
+    let fp = f.map(pt);
+    let c = centroid3(fp[0], fp[1], fp[2]);
+    let mut size: f64 = 0.0;
+    for &i in &near {
+        for &v in &cf[i] {
+            size = size.max(parafront_geom::dist(pt(v), c));
+        }
+    }
+    let mut planes: Vec<(P3, P3)> = near
+        .iter()
+        .map(|&i| {
+            let p = cf[i].map(pt);
+            (centroid3(p[0], p[1], p[2]), tri_normal(p[0], p[1], p[2]))
+        })
+        .collect();
+    for k in 0..3 {
+        let mut n = [0.0; 3];
+        n[k] = 1.0;
+        let mut lo = c;
+        lo[k] -= size;
+        planes.push((lo, n));
+        n[k] = -1.0;
+        let mut hi = c;
+        hi[k] += size;
+        planes.push((hi, n));
+    }
+    let (q, depth) = deepest_point(&planes)?;
+    if !(depth > 0.0) {
+        return None;
+    }
+    let sees = near.iter().all(|&i| {
+        let p = cf[i].map(pt);
+        orient3d(p[0], p[1], p[2], q) > 0.0
+    });
+    (sees && inside(tri, cf, q)).then_some(q)
+}
+
+/// Whether `q` lies strictly inside the closed surface `cf`: a ray's
+/// crossings, counted with the exact segment-triangle test, along the first
+/// of a few directions that meets no edge or corner.
+fn inside(tri: &Triangulation, cf: &[[u32; 3]], q: P3) -> bool {
+    use parafront_geom::intersect::segment_triangle_parity;
+    let far = 1e3
+        * tri.pts[0]
+            .iter()
+            .zip(&q)
+            .map(|(a, b)| (a - b).abs())
+            .fold(1.0, f64::max);
+    let dirs = [
+        [0.577, 0.0321, 0.816],
+        [-0.31, 0.77, 0.2],
+        [0.11, -0.43, -0.9],
+        [0.7, 0.7, -0.14],
+    ];
+    'dir: for d in dirs {
+        let e = [q[0] + far * d[0], q[1] + far * d[1], q[2] + far * d[2]];
+        let mut odd = false;
+        for f in cf {
+            let p = f.map(|v| tri.pts[v as usize]);
+            match segment_triangle_parity(q, e, p[0], p[1], p[2]) {
+                Some(true) => odd = !odd,
+                Some(false) => {}
+                None => continue 'dir,
+            }
+        }
+        return odd;
+    }
+    false
+}

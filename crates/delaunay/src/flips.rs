@@ -1,0 +1,184 @@
+//! Local re-triangulations that keep a triangulation valid: the 2-3 flip
+//! and edge removal (3-2, 4-4 and larger rings, by a fan over the ring).
+//! Each is tried, checked exactly, and done only when every new tet is
+//! positive; faces in `protect` are never removed.
+use crate::tri::{Triangulation, NONE, TET_FACES};
+use parafront_geom::orient3d;
+use rustc_hash::{FxHashMap, FxHashSet};
+
+/// What a local operation did.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Flip {
+    Done,
+    /// A new tet would not be positive.
+    NotConvex,
+    /// It would remove a protected face or edge.
+    Protected,
+    /// The configuration does not allow it (an open ring, a bounding face).
+    NotApplicable,
+}
+
+#[inline]
+pub(crate) fn key3(mut w: [u32; 3]) -> [u32; 3] {
+    w.sort_unstable();
+    w
+}
+
+impl Triangulation {
+    /// Replace the live tets `old` (which must form a region) by `new`
+    /// (positive tets covering the same region), relinking the faces.
+    pub(crate) fn replace(&mut self, old: &[u32], new: &[[u32; 4]]) -> Vec<u32> {
+        let mut outer: FxHashMap<[u32; 3], u32> = FxHashMap::default();
+        let olds: FxHashSet<u32> = old.iter().copied().collect();
+        for &t in old {
+            let tv = self.tets[t as usize];
+            for f in 0..4 {
+                let nb = self.neigh[4 * t as usize + f];
+                if nb != NONE && olds.contains(&(nb >> 2)) {
+                    continue;
+                }
+                outer.insert(key3(TET_FACES[f].map(|k| tv[k])), nb);
+            }
+        }
+        for &t in old {
+            self.kill_tet(t);
+        }
+        let mut inner: FxHashMap<[u32; 3], u32> = FxHashMap::default();
+        let mut made = Vec::with_capacity(new.len());
+        for &tv in new {
+            let t = self.new_tet(tv);
+            made.push(t);
+            for f in 0..4 {
+                let k = key3(TET_FACES[f].map(|i| tv[i]));
+                let fr = 4 * t + f as u32;
+                if let Some(nb) = outer.remove(&k) {
+                    self.neigh[fr as usize] = nb;
+                    if nb != NONE {
+                        self.neigh[nb as usize] = fr;
+                    }
+                } else if let Some(o) = inner.remove(&k) {
+                    self.link(fr, o);
+                } else {
+                    inner.insert(k, fr);
+                }
+            }
+            for &v in &tv {
+                self.vtet[v as usize] = t;
+            }
+        }
+        debug_assert!(
+            outer.is_empty() && inner.is_empty(),
+            "re-triangulation does not match its region"
+        );
+        made
+    }
+
+    /// 2-3 flip of face `4t+f`: the two tets on it become three around the
+    /// edge between their apexes.
+    pub fn flip23(&mut self, fr: u32, protect: &FxHashSet<[u32; 3]>) -> Flip {
+        let (t, f) = (fr >> 2, (fr & 3) as usize);
+        let nb = self.neigh[fr as usize];
+        if nb == NONE {
+            return Flip::NotApplicable;
+        }
+        let tv = self.tets[t as usize];
+        let w = TET_FACES[f].map(|k| tv[k]);
+        if protect.contains(&key3(w)) {
+            return Flip::Protected;
+        }
+        let a = tv[f];
+        let b = self.tets[(nb >> 2) as usize][(nb & 3) as usize];
+        // w is outward from t, so b lies on its normal side.
+        let mut new = Vec::with_capacity(3);
+        for i in 0..3 {
+            let (x, y) = (w[i], w[(i + 1) % 3]);
+            // (x, y, b, a) is positive iff the edge a-b passes inside w
+            // on the far side of x-y from w's third corner.
+            let tv2 = [x, y, a, b];
+            let p = tv2.map(|v| self.pts[v as usize]);
+            if orient3d(p[0], p[1], p[2], p[3]) <= 0.0 {
+                return Flip::NotConvex;
+            }
+            new.push(tv2);
+        }
+        self.replace(&[t, nb >> 2], &new);
+        Flip::Done
+    }
+
+    /// The tets around edge `p`-`q` and the ring of their other corners in
+    /// order, or `None` when the ring is open or the edge is missing.
+    pub(crate) fn edge_ring(&self, p: u32, q: u32) -> Option<(Vec<u32>, Vec<u32>)> {
+        let tets: Vec<u32> = self
+            .star(p)
+            .into_iter()
+            .filter(|&t| self.tets[t as usize].contains(&q))
+            .collect();
+        if tets.len() < 3 {
+            return None;
+        }
+        // Each tet as (its two other corners in the order that makes
+        // (p, q, r0, r1) positive).
+        let mut next: FxHashMap<u32, u32> = FxHashMap::default();
+        for &t in &tets {
+            let o: Vec<u32> = self.tets[t as usize]
+                .iter()
+                .copied()
+                .filter(|&v| v != p && v != q)
+                .collect();
+            let pts = [p, q, o[0], o[1]].map(|v| self.pts[v as usize]);
+            let (r0, r1) = if orient3d(pts[0], pts[1], pts[2], pts[3]) > 0.0 {
+                (o[0], o[1])
+            } else {
+                (o[1], o[0])
+            };
+            next.insert(r0, r1);
+        }
+        let start = *next.keys().min()?;
+        let mut ring = vec![start];
+        let mut v = start;
+        for _ in 0..tets.len() {
+            v = *next.get(&v)?;
+            if v == start {
+                break;
+            }
+            ring.push(v);
+        }
+        (ring.len() == tets.len()).then_some((tets, ring))
+    }
+
+    /// Remove edge `p`-`q`: its ring of tets is re-triangulated as a fan
+    /// over the ring polygon joined to `p` and to `q` (a 3-2 flip for a
+    /// ring of three, 4-4 for four). Every fan apex is tried.
+    pub fn remove_edge(&mut self, p: u32, q: u32, protect: &FxHashSet<[u32; 3]>) -> Flip {
+        let Some((tets, ring)) = self.edge_ring(p, q) else {
+            return Flip::NotApplicable;
+        };
+        let n = ring.len();
+        for &r in &ring {
+            if protect.contains(&key3([p, q, r])) {
+                return Flip::Protected;
+            }
+        }
+        let pt = |v: u32| self.pts[v as usize];
+        'apex: for k in 0..n {
+            let mut new = Vec::with_capacity(2 * (n - 2));
+            for i in 1..n - 1 {
+                let (a, b, c) = (ring[k], ring[(k + i) % n], ring[(k + i + 1) % n]);
+                // (p, q, a, b) positive means the ring turns (a -> b) about
+                // p -> q; the triangle (a, b, c) then has q ... check both.
+                let tq = [a, b, c, q];
+                let tp = [a, c, b, p];
+                for tv in [tq, tp] {
+                    if orient3d(pt(tv[0]), pt(tv[1]), pt(tv[2]), pt(tv[3])) <= 0.0 {
+                        continue 'apex;
+                    }
+                }
+                new.push(tq);
+                new.push(tp);
+            }
+            self.replace(&tets, &new);
+            return Flip::Done;
+        }
+        Flip::NotConvex
+    }
+}

@@ -1,0 +1,28 @@
+//! The Delaunay kernel, and the constrained fill of a cavity the front
+//! cannot close (issue 20).
+//!
+//! The paper's §2 names the two scalar methods, the advancing front and the
+//! generalized Delaunay triangulation (GDT). This crate is the second's
+//! kernel: a tet store with `4t+f` adjacency ([`Triangulation`]), point
+//! insertion by Bowyer-Watson with exact predicates and a symbolic
+//! perturbation of the in-sphere test (so cospherical and coplanar points
+//! need no special case), 2-3 flips and edge removal, and a `check()` of
+//! validity and of the Delaunay property.
+//!
+//! [`fill_cavity`] builds on it: given a closed triangulated surface (a
+//! stalled front's cavity), it returns tets that fill it exactly and keep
+//! every surface triangle. It triangulates the cavity's points, recovers the
+//! missing faces by flips, adds Steiner points strictly inside the cavity
+//! where flips cannot, and keeps the tets inside.
+mod check;
+mod fill;
+mod flips;
+mod predicates;
+mod recover;
+mod tri;
+
+pub use check::CheckError;
+pub use fill::{fill_cavity, Fill, FillError, FillMethod, FillOptions};
+pub use flips::Flip;
+pub use predicates::in_sphere;
+pub use tri::{InsertError, Triangulation, NONE, TET_FACES};

@@ -1,0 +1,223 @@
+//! Recovery of constraint faces by flips: an edge of the triangulation that
+//! pierces a missing face is removed (3-2, 4-4, ...), a face that a missing
+//! face's edge pierces is flipped 2-3, until the face appears or no flip
+//! applies. Faces already present are protected.
+use crate::flips::{key3, Flip};
+use crate::tri::{Triangulation, NONE, TET_FACES};
+use parafront_geom::{add, cross, orient3d, sub, P3};
+use rustc_hash::FxHashSet;
+
+/// Recover every face of `cf` it can, in passes while any pass gains one;
+/// the indices of the faces still missing.
+pub(crate) fn recover_all(
+    tri: &mut Triangulation,
+    cf: &[[u32; 3]],
+    per_face: usize,
+    flips: &mut usize,
+) -> Vec<usize> {
+    let mut missing: Vec<usize> = Vec::new();
+    let mut protect: FxHashSet<[u32; 3]> = FxHashSet::default();
+    for (i, &f) in cf.iter().enumerate() {
+        if tri.find_face(f).is_some() {
+            protect.insert(key3(f));
+        } else {
+            missing.push(i);
+        }
+    }
+    loop {
+        let before = missing.len();
+        let mut still = Vec::new();
+        for &i in &missing {
+            if recover_face(tri, cf[i], &protect, per_face, flips) {
+                protect.insert(key3(cf[i]));
+            } else {
+                still.push(i);
+            }
+        }
+        missing = still;
+        if missing.is_empty() || missing.len() == before {
+            return missing;
+        }
+    }
+}
+
+fn recover_face(
+    tri: &mut Triangulation,
+    f: [u32; 3],
+    protect: &FxHashSet<[u32; 3]>,
+    budget: usize,
+    flips: &mut usize,
+) -> bool {
+    for _ in 0..budget {
+        if tri.find_face(f).is_some() {
+            return true;
+        }
+        let (edges, faces) = crossings(tri, f);
+        let mut done = false;
+        for (u, v) in edges {
+            if tri.remove_edge(u, v, protect) == Flip::Done {
+                done = true;
+                break;
+            }
+        }
+        if !done {
+            for fr in faces {
+                if tri.flip23(fr, protect) == Flip::Done {
+                    done = true;
+                    break;
+                }
+            }
+        }
+        if !done {
+            return false;
+        }
+        *flips += 1;
+    }
+    tri.find_face(f).is_some()
+}
+
+/// The triangulation's edges that meet face `f` (outside its own edges),
+/// and its faces that an edge of `f` pierces, found among the tets near
+/// `f`.
+fn crossings(tri: &Triangulation, f: [u32; 3]) -> (Vec<(u32, u32)>, Vec<u32>) {
+    let p = f.map(|v| tri.pts[v as usize]);
+    let mut lo = p[0];
+    let mut hi = p[0];
+    for q in &p[1..] {
+        for k in 0..3 {
+            lo[k] = lo[k].min(q[k]);
+            hi[k] = hi[k].max(q[k]);
+        }
+    }
+    // A point off the face's plane, to order points within it.
+    let off = add(p[0], cross(sub(p[1], p[0]), sub(p[2], p[0])));
+    // Tets whose box meets the face's box, grown from its corners' stars.
+    let mut seen: FxHashSet<u32> = FxHashSet::default();
+    let mut near: Vec<u32> = Vec::new();
+    for &v in &f {
+        for t in tri.star(v) {
+            if seen.insert(t) {
+                near.push(t);
+            }
+        }
+    }
+    let mut i = 0;
+    while i < near.len() {
+        let t = near[i];
+        i += 1;
+        for k in 0..4 {
+            let nb = tri.neighbour(t, k);
+            if nb == NONE || seen.contains(&(nb >> 2)) {
+                continue;
+            }
+            let u = nb >> 2;
+            let tp = tri.tet_points(u);
+            let meets = (0..3)
+                .all(|d| tp.iter().any(|q| q[d] >= lo[d]) && tp.iter().any(|q| q[d] <= hi[d]));
+            seen.insert(u);
+            if meets {
+                near.push(u);
+            }
+        }
+    }
+    let mut edges: Vec<(u32, u32)> = Vec::new();
+    let mut eseen: FxHashSet<(u32, u32)> = FxHashSet::default();
+    let mut faces: Vec<u32> = Vec::new();
+    let mut fseen: FxHashSet<[u32; 3]> = FxHashSet::default();
+    for &t in &near {
+        let tv = tri.tet(t);
+        for a in 0..4 {
+            for b in a + 1..4 {
+                let (u, v) = (tv[a].min(tv[b]), tv[a].max(tv[b]));
+                if f.contains(&u) && f.contains(&v) || !eseen.insert((u, v)) {
+                    continue;
+                }
+                if edge_blocks(tri, p, f, off, u, v) {
+                    edges.push((u, v));
+                }
+            }
+        }
+        for k in 0..4 {
+            let w = TET_FACES[k].map(|j| tv[j]);
+            if tri.neighbour(t, k) == NONE || !fseen.insert(key3(w)) {
+                continue;
+            }
+            let wp = w.map(|v| tri.pts[v as usize]);
+            let pierced = (0..3).any(|e| {
+                let (a, b) = (f[e], f[(e + 1) % 3]);
+                !w.contains(&a)
+                    && !w.contains(&b)
+                    && pierces(tri.pts[a as usize], tri.pts[b as usize], wp)
+            });
+            if pierced {
+                faces.push(4 * t + k as u32);
+            }
+        }
+    }
+    (edges, faces)
+}
+
+/// Edge `u`-`v` meets face `f` (points `p`) elsewhere than along its own
+/// edges' ends: through its interior, or through one of its edges, or
+/// lying in its plane across it.
+fn edge_blocks(tri: &Triangulation, p: [P3; 3], f: [u32; 3], off: P3, u: u32, v: u32) -> bool {
+    let (pu, pv) = (tri.pts[u as usize], tri.pts[v as usize]);
+    let ou = orient3d(p[0], p[1], p[2], pu);
+    let ov = orient3d(p[0], p[1], p[2], pv);
+    if opp(ou, ov) {
+        let s = [
+            orient3d(pu, pv, p[0], p[1]),
+            orient3d(pu, pv, p[1], p[2]),
+            orient3d(pu, pv, p[2], p[0]),
+        ];
+        let zeros = s.iter().filter(|&&x| x == 0.0).count();
+        return zeros < 2 && (s.iter().all(|&x| x >= 0.0) || s.iter().all(|&x| x <= 0.0));
+    }
+    if ou == 0.0 && ov == 0.0 {
+        // In the face's plane: it crosses one of the face's edges properly,
+        // or has an end strictly inside the face.
+        let o2 = |a: P3, b: P3, c: P3| orient3d(a, b, c, off);
+        for e in 0..3 {
+            let (a, b) = (p[e], p[(e + 1) % 3]);
+            if f[e] == u || f[e] == v || f[(e + 1) % 3] == u || f[(e + 1) % 3] == v {
+                continue;
+            }
+            let s1 = o2(a, b, pu);
+            let s2 = o2(a, b, pv);
+            let s3 = o2(pu, pv, a);
+            let s4 = o2(pu, pv, b);
+            if opp(s1, s2) && opp(s3, s4) {
+                return true;
+            }
+        }
+        let strictly_in = |x: P3| {
+            let s = [o2(p[0], p[1], x), o2(p[1], p[2], x), o2(p[2], p[0], x)];
+            s.iter().all(|&y| y > 0.0) || s.iter().all(|&y| y < 0.0)
+        };
+        return strictly_in(pu) || strictly_in(pv);
+    }
+    false
+}
+
+/// Segment `a`-`b` passes through triangle `w` (its interior or an edge's
+/// interior), its ends strictly on either side.
+fn pierces(a: P3, b: P3, w: [P3; 3]) -> bool {
+    let oa = orient3d(w[0], w[1], w[2], a);
+    let ob = orient3d(w[0], w[1], w[2], b);
+    if !opp(oa, ob) {
+        return false;
+    }
+    let s = [
+        orient3d(a, b, w[0], w[1]),
+        orient3d(a, b, w[1], w[2]),
+        orient3d(a, b, w[2], w[0]),
+    ];
+    let zeros = s.iter().filter(|&&x| x == 0.0).count();
+    zeros < 2 && (s.iter().all(|&x| x >= 0.0) || s.iter().all(|&x| x <= 0.0))
+}
+
+/// Strictly opposite signs (a product could underflow).
+#[inline]
+fn opp(a: f64, b: f64) -> bool {
+    (a > 0.0 && b < 0.0) || (a < 0.0 && b > 0.0)
+}

@@ -1,0 +1,468 @@
+//! The tet store and Bowyer-Watson insertion.
+use crate::predicates::in_sphere_sos;
+use parafront_geom::{orient3d, Aabb, P3};
+use rustc_hash::FxHashMap;
+
+/// No tet: the outside of the bounding tet, or a dead slot.
+pub const NONE: u32 = u32::MAX;
+
+/// The faces of tet `[a, b, c, d]`, face `i` opposite corner `i`, each with
+/// its right-hand normal pointing out of a positive tet (parafront's
+/// convention, as `parafront_mesh::TET_FACES`).
+pub const TET_FACES: [[usize; 3]; 4] = [[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]];
+
+/// Why a point was not inserted.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum InsertError {
+    #[error("point {0:?} is not finite")]
+    NotFinite(P3),
+    #[error("point {0:?} lies outside the bounding tet")]
+    Outside(P3),
+    #[error("point {0:?} coincides with point {1}")]
+    Duplicate(P3, u32),
+}
+
+/// A tetrahedralization of a bounding tet: struct of arrays, `u32` ids,
+/// `neigh[4t+f] = 4u+g` (or [`NONE`] on the bounding tet's faces).
+///
+/// Points `0..4` are the bounding tet's corners; the points given to
+/// [`Triangulation::new`] follow in order. Dead tets keep their slot (their
+/// `alive` is false) and are reused.
+#[derive(Clone, Debug)]
+pub struct Triangulation {
+    pub(crate) pts: Vec<P3>,
+    pub(crate) tets: Vec<[u32; 4]>,
+    pub(crate) neigh: Vec<u32>,
+    pub(crate) alive: Vec<bool>,
+    free: Vec<u32>,
+    /// A live tet on each point (a hint, refreshed on use).
+    pub(crate) vtet: Vec<u32>,
+    last: u32,
+    // Scratch for insertion.
+    conflict: Vec<u32>,
+    mark: Vec<u32>,
+    epoch: u32,
+}
+
+impl Triangulation {
+    /// The Delaunay tetrahedralization of `points`, inserted in a spatially
+    /// coherent order inside a bounding tet far around them.
+    pub fn new(points: &[P3]) -> Result<Triangulation, InsertError> {
+        let mut t = Triangulation::bounding(points)?;
+        for i in brio_order(points) {
+            t.insert_with_id(4 + i as u32)?;
+        }
+        Ok(t)
+    }
+
+    /// Only the bounding tet of `points`, with the points stored but not
+    /// inserted (ids `4..`): `insert_id` adds them one at a time.
+    pub fn bounding(points: &[P3]) -> Result<Triangulation, InsertError> {
+        if let Some(p) = points.iter().find(|p| !p.iter().all(|x| x.is_finite())) {
+            return Err(InsertError::NotFinite(*p));
+        }
+        let bb = if points.is_empty() {
+            Aabb {
+                min: [0.0; 3],
+                max: [1.0; 3],
+            }
+        } else {
+            Aabb::from_points(points)
+        };
+        let c = bb.center();
+        // A scale the predicates resolve without underflow, also for one
+        // point or coincident ones.
+        let mag = c.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        let d = bb.diagonal();
+        let r = 50.0
+            * if d > 1e-9 * mag && d > 1e-100 {
+                d
+            } else {
+                mag.max(1.0)
+            };
+        // A regular tet whose insphere has radius r about c.
+        let s = 3.0 * r;
+        let corners = [
+            [c[0] + s, c[1] + s, c[2] + s],
+            [c[0] - s, c[1] - s, c[2] + s],
+            [c[0] - s, c[1] + s, c[2] - s],
+            [c[0] + s, c[1] - s, c[2] - s],
+        ];
+        let mut pts = corners.to_vec();
+        pts.extend_from_slice(points);
+        let mut tv = [0u32, 1, 2, 3];
+        if orient3d(pts[0], pts[1], pts[2], pts[3]) < 0.0 {
+            tv.swap(2, 3);
+        }
+        let n = pts.len();
+        Ok(Triangulation {
+            pts,
+            tets: vec![tv],
+            neigh: vec![NONE; 4],
+            alive: vec![true],
+            free: Vec::new(),
+            vtet: vec![NONE; n],
+            last: 0,
+            conflict: Vec::new(),
+            mark: vec![0],
+            epoch: 0,
+        })
+        .map(|mut t| {
+            for k in 0..4 {
+                t.vtet[k] = 0;
+            }
+            t
+        })
+    }
+
+    pub fn points(&self) -> &[P3] {
+        &self.pts
+    }
+    /// Whether point `i` is a corner of the bounding tet.
+    pub fn is_bounding(&self, i: u32) -> bool {
+        i < 4
+    }
+    /// Tet slots, dead ones included (see [`Triangulation::is_alive`]).
+    pub fn tet_slots(&self) -> usize {
+        self.tets.len()
+    }
+    pub fn tet(&self, t: u32) -> [u32; 4] {
+        self.tets[t as usize]
+    }
+    pub fn is_alive(&self, t: u32) -> bool {
+        self.alive[t as usize]
+    }
+    pub fn neighbour(&self, t: u32, f: usize) -> u32 {
+        self.neigh[4 * t as usize + f]
+    }
+    /// Live tets.
+    pub fn live_tets(&self) -> impl Iterator<Item = u32> + '_ {
+        (0..self.tets.len() as u32).filter(|&t| self.alive[t as usize])
+    }
+    /// Live tets none of whose corners is a bounding corner.
+    pub fn inner_tets(&self) -> impl Iterator<Item = u32> + '_ {
+        self.live_tets()
+            .filter(|&t| self.tets[t as usize].iter().all(|&v| v >= 4))
+    }
+
+    pub(crate) fn tet_points(&self, t: u32) -> [P3; 4] {
+        self.tets[t as usize].map(|v| self.pts[v as usize])
+    }
+
+    /// Add a point and insert it: its id.
+    pub fn insert(&mut self, p: P3) -> Result<u32, InsertError> {
+        if !p.iter().all(|x| x.is_finite()) {
+            return Err(InsertError::NotFinite(p));
+        }
+        let id = self.pts.len() as u32;
+        self.pts.push(p);
+        self.vtet.push(NONE);
+        match self.insert_with_id(id) {
+            Ok(()) => Ok(id),
+            Err(e) => {
+                self.pts.pop();
+                self.vtet.pop();
+                Err(e)
+            }
+        }
+    }
+
+    /// The live tet that holds `p` (in its closure), by a visibility walk
+    /// from `start`; a scan when the walk runs long (a triangulation that
+    /// flips have made non-Delaunay can cycle it).
+    pub fn locate(&self, p: P3, start: u32) -> Option<u32> {
+        let mut t = if start != NONE && self.alive[start as usize] {
+            start
+        } else {
+            self.live_tets().next()?
+        };
+        let mut seed = 0x9e37_79b9u32 ^ t;
+        let limit = 64 + 4 * (self.tets.len() as f64).sqrt() as usize * 8;
+        'walk: for _ in 0..limit {
+            let tp = self.tet_points(t);
+            seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            let r = (seed >> 28) as usize;
+            for k in 0..4 {
+                let f = (r + k) & 3;
+                let fv = TET_FACES[f];
+                if orient3d(tp[fv[0]], tp[fv[1]], tp[fv[2]], p) > 0.0 {
+                    let nb = self.neigh[4 * t as usize + f];
+                    if nb == NONE {
+                        return None;
+                    }
+                    t = nb >> 2;
+                    continue 'walk;
+                }
+            }
+            return Some(t);
+        }
+        self.live_tets().find(|&t| self.holds(t, p))
+    }
+
+    /// `p` lies in the closed tet `t`.
+    pub fn holds(&self, t: u32, p: P3) -> bool {
+        let tp = self.tet_points(t);
+        TET_FACES
+            .iter()
+            .all(|fv| orient3d(tp[fv[0]], tp[fv[1]], tp[fv[2]], p) <= 0.0)
+    }
+
+    fn new_epoch(&mut self) -> u32 {
+        self.epoch = self.epoch.wrapping_add(1);
+        if self.epoch == 0 {
+            self.mark.iter_mut().for_each(|m| *m = 0);
+            self.epoch = 1;
+        }
+        self.mark.resize(self.tets.len(), 0);
+        self.epoch
+    }
+
+    /// Bowyer-Watson: the tets whose perturbed circumsphere holds point
+    /// `id`, grown from the tet that holds it, are replaced by cones from
+    /// it. A cone that would be flat (a degenerate input the perturbation
+    /// leaves flat) takes the tet beyond it into the cavity as well.
+    pub(crate) fn insert_with_id(&mut self, id: u32) -> Result<(), InsertError> {
+        let p = self.pts[id as usize];
+        let t0 = self.locate(p, self.last).ok_or(InsertError::Outside(p))?;
+        for &v in &self.tets[t0 as usize] {
+            if self.pts[v as usize] == p {
+                return Err(InsertError::Duplicate(p, v));
+            }
+        }
+        let ep = self.new_epoch();
+        let mut cav = std::mem::take(&mut self.conflict);
+        cav.clear();
+        cav.push(t0);
+        self.mark[t0 as usize] = ep;
+        let mut i = 0;
+        while i < cav.len() {
+            let t = cav[i];
+            i += 1;
+            for f in 0..4 {
+                let nb = self.neigh[4 * t as usize + f];
+                if nb == NONE || self.mark[(nb >> 2) as usize] == ep {
+                    continue;
+                }
+                let u = nb >> 2;
+                if in_sphere_sos(self.tets[u as usize], self.tet_points(u), id, p) {
+                    self.mark[u as usize] = ep;
+                    cav.push(u);
+                }
+            }
+        }
+        self.star_cavity(id, &mut cav, ep)?;
+        self.replace_by_cones(id, &cav, ep, None);
+        self.conflict = cav;
+        Ok(())
+    }
+
+    /// Grow the cavity `cav` (marked `ep`) until point `id` sees every face
+    /// of its boundary strictly from inside.
+    pub(crate) fn star_cavity(
+        &mut self,
+        id: u32,
+        cav: &mut Vec<u32>,
+        ep: u32,
+    ) -> Result<(), InsertError> {
+        let p = self.pts[id as usize];
+        loop {
+            let mut grew = false;
+            let mut i = 0;
+            while i < cav.len() {
+                let t = cav[i];
+                i += 1;
+                for f in 0..4 {
+                    let nb = self.neigh[4 * t as usize + f];
+                    if nb != NONE && self.mark[(nb >> 2) as usize] == ep {
+                        continue;
+                    }
+                    let tv = self.tets[t as usize];
+                    let fv = TET_FACES[f].map(|k| self.pts[tv[k] as usize]);
+                    if orient3d(fv[0], fv[1], fv[2], p) < 0.0 {
+                        continue;
+                    }
+                    if nb == NONE {
+                        return Err(InsertError::Outside(p));
+                    }
+                    let u = nb >> 2;
+                    self.mark[u as usize] = ep;
+                    cav.push(u);
+                    grew = true;
+                }
+            }
+            if !grew {
+                return Ok(());
+            }
+        }
+    }
+
+    /// Replace the cavity `cav` (marked `ep`, star-shaped about point `id`)
+    /// by the cones from `id` over its boundary faces. `kept`, when given,
+    /// collects the new tets.
+    pub(crate) fn replace_by_cones(
+        &mut self,
+        id: u32,
+        cav: &[u32],
+        ep: u32,
+        mut kept: Option<&mut Vec<u32>>,
+    ) {
+        // Boundary faces: (outer face ref or NONE, the face's corners as
+        // seen from the cavity, outward).
+        let mut bnd: Vec<(u32, [u32; 3])> = Vec::new();
+        for &t in cav {
+            let tv = self.tets[t as usize];
+            for f in 0..4 {
+                let nb = self.neigh[4 * t as usize + f];
+                if nb != NONE && self.mark[(nb >> 2) as usize] == ep {
+                    continue;
+                }
+                bnd.push((nb, TET_FACES[f].map(|k| tv[k])));
+            }
+        }
+        for &t in cav {
+            self.alive[t as usize] = false;
+            self.free.push(t);
+        }
+        let mut edges: FxHashMap<(u32, u32), u32> = FxHashMap::default();
+        for (nb, w) in bnd {
+            // Outward face w seen from inside: the cone (w0, w2, w1, id) is
+            // positive, its face 3 is w reversed... i.e. w itself outward.
+            let tv = [w[0], w[2], w[1], id];
+            let t = self.new_tet(tv);
+            if let Some(k) = kept.as_deref_mut() {
+                k.push(t);
+            }
+            self.neigh[4 * t as usize + 3] = nb;
+            if nb != NONE {
+                self.neigh[nb as usize] = 4 * t + 3;
+            }
+            // Faces 0, 1, 2 hold `id` and the edge opposite corner 0, 1, 2.
+            for f in 0..3 {
+                let fv = TET_FACES[f];
+                let e: Vec<u32> = fv.iter().map(|&k| tv[k]).filter(|&v| v != id).collect();
+                let key = (e[0].min(e[1]), e[0].max(e[1]));
+                let fr = 4 * t + f as u32;
+                if let Some(o) = edges.remove(&key) {
+                    self.neigh[fr as usize] = o;
+                    self.neigh[o as usize] = fr;
+                } else {
+                    edges.insert(key, fr);
+                }
+            }
+            for &v in &tv {
+                self.vtet[v as usize] = t;
+            }
+            self.last = t;
+        }
+        debug_assert!(edges.is_empty(), "cavity boundary is not closed");
+    }
+
+    pub(crate) fn new_tet(&mut self, tv: [u32; 4]) -> u32 {
+        if let Some(t) = self.free.pop() {
+            self.tets[t as usize] = tv;
+            self.alive[t as usize] = true;
+            for f in 0..4 {
+                self.neigh[4 * t as usize + f] = NONE;
+            }
+            t
+        } else {
+            let t = self.tets.len() as u32;
+            self.tets.push(tv);
+            self.alive.push(true);
+            self.neigh.extend_from_slice(&[NONE; 4]);
+            self.mark.push(0);
+            t
+        }
+    }
+
+    pub(crate) fn kill_tet(&mut self, t: u32) {
+        self.alive[t as usize] = false;
+        self.free.push(t);
+    }
+
+    /// Link face `a` (`4t+f`) and face `b` both ways.
+    pub(crate) fn link(&mut self, a: u32, b: u32) {
+        if a != NONE {
+            self.neigh[a as usize] = b;
+        }
+        if b != NONE {
+            self.neigh[b as usize] = a;
+        }
+    }
+
+    /// The live tets around point `v`.
+    pub fn star(&self, v: u32) -> Vec<u32> {
+        let mut t0 = self.vtet[v as usize];
+        if t0 == NONE || !self.alive[t0 as usize] || !self.tets[t0 as usize].contains(&v) {
+            match self
+                .live_tets()
+                .find(|&t| self.tets[t as usize].contains(&v))
+            {
+                Some(t) => t0 = t,
+                None => return Vec::new(),
+            }
+        }
+        let mut out = vec![t0];
+        let mut seen = rustc_hash::FxHashSet::default();
+        seen.insert(t0);
+        let mut i = 0;
+        while i < out.len() {
+            let t = out[i];
+            i += 1;
+            let tv = self.tets[t as usize];
+            for f in 0..4 {
+                if tv[f] == v {
+                    continue; // the face opposite v does not hold it
+                }
+                let nb = self.neigh[4 * t as usize + f];
+                if nb != NONE && seen.insert(nb >> 2) {
+                    out.push(nb >> 2);
+                }
+            }
+        }
+        out
+    }
+
+    /// The tet face `4t+f` with corners `w` (any order), if it exists.
+    pub fn find_face(&self, w: [u32; 3]) -> Option<u32> {
+        for t in self.star(w[0]) {
+            let tv = self.tets[t as usize];
+            if w.iter().all(|x| tv.contains(x)) {
+                let f = (0..4).find(|&k| !w.contains(&tv[k])).unwrap();
+                return Some(4 * t + f as u32);
+            }
+        }
+        None
+    }
+}
+
+/// Insertion order: along a Morton curve, so that each walk is short and
+/// runs are repeatable.
+fn brio_order(points: &[P3]) -> Vec<usize> {
+    if points.is_empty() {
+        return Vec::new();
+    }
+    let bb = Aabb::from_points(points);
+    let ext = (0..3)
+        .map(|k| bb.max[k] - bb.min[k])
+        .fold(0.0, f64::max)
+        .max(1e-300);
+    let key = |p: &P3| -> u64 {
+        let q: [u64; 3] =
+            [0, 1, 2].map(|d| (((p[d] - bb.min[d]) / ext * 1_048_575.0) as u64).min(1_048_575));
+        let mut k = 0u64;
+        for bit in (0..20).rev() {
+            for &c in &q {
+                k = (k << 1) | ((c >> bit) & 1);
+            }
+        }
+        k
+    };
+    let mut idx: Vec<(u64, usize)> = points
+        .iter()
+        .enumerate()
+        .map(|(i, p)| (key(p), i))
+        .collect();
+    idx.sort_unstable();
+    idx.into_iter().map(|x| x.1).collect()
+}

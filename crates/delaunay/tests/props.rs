@@ -1,0 +1,335 @@
+//! Property tests: the kernel on random and degenerate point sets, the fill
+//! on star-shaped, convex, twisted and slotted cavities.
+use parafront_delaunay::{fill_cavity, Fill, FillMethod, FillOptions, Triangulation, TET_FACES};
+use parafront_geom::{orient3d, P3};
+use proptest::prelude::*;
+use std::collections::HashMap;
+
+fn grid(n: usize) -> Vec<P3> {
+    let mut v = Vec::new();
+    for i in 0..n {
+        for j in 0..n {
+            for k in 0..n {
+                v.push([i as f64, j as f64, k as f64]);
+            }
+        }
+    }
+    v
+}
+
+fn sphere_points(n: usize, seed: u64) -> Vec<P3> {
+    // Points on a sphere, rounded so that many are exactly cospherical
+    // only up to the perturbation.
+    let mut s = seed;
+    let mut next = || {
+        s = s
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((s >> 11) as f64) / ((1u64 << 53) as f64)
+    };
+    (0..n)
+        .map(|_| {
+            let z: f64 = 2.0 * next() - 1.0;
+            let t = 6.283185307179586 * next();
+            let r = (1.0 - z * z).sqrt();
+            [r * t.cos(), r * t.sin(), z]
+        })
+        .collect()
+}
+
+fn checked(points: &[P3]) -> Triangulation {
+    let t = Triangulation::new(points).expect("insert");
+    t.check().expect("valid");
+    t.check_delaunay().expect("Delaunay");
+    // The inner tets fill the hull: their volume is the hull's.
+    t
+}
+
+#[test]
+fn cube_grid_is_valid_and_delaunay() {
+    let pts = grid(5);
+    let t = checked(&pts);
+    let vol: f64 = t
+        .inner_tets()
+        .map(|k| {
+            let p = t.tet(k).map(|v| t.points()[v as usize]);
+            orient3d(p[0], p[1], p[2], p[3]) / 6.0
+        })
+        .sum();
+    assert!((vol - 64.0).abs() < 1e-9, "grid hull volume {vol}");
+}
+
+#[test]
+fn coplanar_points_and_one_above() {
+    let mut pts: Vec<P3> = grid(6).into_iter().filter(|p| p[2] == 0.0).collect();
+    checked(&pts);
+    pts.push([2.5, 2.5, 1.0]);
+    let t = checked(&pts);
+    assert!(t.inner_tets().count() > 0);
+}
+
+#[test]
+fn duplicate_point_is_an_error() {
+    let pts = vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0; 3]];
+    assert!(Triangulation::new(&pts).is_err());
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(48))]
+    #[test]
+    fn random_points(pts in prop::collection::vec(prop::array::uniform3(-1.0f64..1.0), 1..200)) {
+        let mut pts = pts;
+        pts.sort_by(|a, b| a.partial_cmp(b).unwrap());
+        pts.dedup();
+        checked(&pts);
+    }
+
+    #[test]
+    fn integer_points(pts in prop::collection::vec(prop::array::uniform3(0i32..4), 1..60)) {
+        let mut pts: Vec<P3> = pts.iter().map(|p| p.map(|x| x as f64)).collect();
+        pts.sort_by(|a, b| a.partial_cmp(b).unwrap());
+        pts.dedup();
+        checked(&pts);
+    }
+
+    #[test]
+    fn cospherical_points(n in 5usize..150, seed in any::<u64>()) {
+        checked(&sphere_points(n, seed));
+    }
+}
+
+// ---- the fill ----
+
+/// Every tet positive, each inner face shared by two tets seen from
+/// opposite sides, the free faces exactly the cavity's (reversed), the
+/// volume the enclosed one.
+fn verify(points: &[P3], faces: &[[u32; 3]], fill: &Fill) {
+    let mut all = points.to_vec();
+    all.extend_from_slice(&fill.steiner);
+    let mut half: HashMap<[u32; 3], usize> = HashMap::new();
+    let canon = |w: [u32; 3]| {
+        let m = (0..3).min_by_key(|&i| w[i]).unwrap();
+        [w[m], w[(m + 1) % 3], w[(m + 2) % 3]]
+    };
+    let mut vol = 0.0;
+    for tv in &fill.tets {
+        let p = tv.map(|v| all[v as usize]);
+        let o = orient3d(p[0], p[1], p[2], p[3]);
+        assert!(o > 0.0, "tet {tv:?} not positive");
+        vol += o;
+        for f in TET_FACES {
+            *half.entry(canon(f.map(|k| tv[k]))).or_default() += 1;
+        }
+    }
+    for f in faces {
+        // The cavity face, as the tet inside sees it outward: reversed.
+        *half.entry(canon([f[0], f[2], f[1]])).or_default() += 0;
+        *half.entry(canon(*f)).or_default() += 1;
+    }
+    for (w, &n) in &half {
+        assert_eq!(n, 1, "face {w:?} seen {n} times");
+        let r = canon([w[0], w[2], w[1]]);
+        assert_eq!(half.get(&r), Some(&1), "face {w:?} has no opposite");
+    }
+    let o = points[faces[0][0] as usize];
+    let enclosed: f64 = faces
+        .iter()
+        .map(|f| {
+            let p = f.map(|v| points[v as usize]);
+            orient3d(p[0], p[1], p[2], o)
+        })
+        .sum();
+    assert!(
+        (vol - enclosed).abs() <= 1e-9 * enclosed.abs(),
+        "volume {vol} vs {enclosed}"
+    );
+}
+
+/// An octahedron subdivided `levels` times, projected to the unit sphere,
+/// faces oriented into the inside.
+fn icosphere(levels: usize) -> (Vec<P3>, Vec<[u32; 3]>) {
+    let mut pts: Vec<P3> = vec![
+        [1.0, 0.0, 0.0],
+        [-1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, -1.0, 0.0],
+        [0.0, 0.0, 1.0],
+        [0.0, 0.0, -1.0],
+    ];
+    // Outward first.
+    let mut faces: Vec<[u32; 3]> = vec![
+        [0, 2, 4],
+        [2, 1, 4],
+        [1, 3, 4],
+        [3, 0, 4],
+        [2, 0, 5],
+        [1, 2, 5],
+        [3, 1, 5],
+        [0, 3, 5],
+    ];
+    for _ in 0..levels {
+        let mut mid: HashMap<(u32, u32), u32> = HashMap::new();
+        let mut m = |a: u32, b: u32, pts: &mut Vec<P3>| {
+            *mid.entry((a.min(b), a.max(b))).or_insert_with(|| {
+                let (p, q) = (pts[a as usize], pts[b as usize]);
+                let c = [
+                    (p[0] + q[0]) / 2.0,
+                    (p[1] + q[1]) / 2.0,
+                    (p[2] + q[2]) / 2.0,
+                ];
+                let r = (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt();
+                pts.push([c[0] / r, c[1] / r, c[2] / r]);
+                pts.len() as u32 - 1
+            })
+        };
+        let mut nf = Vec::new();
+        for [a, b, c] in faces {
+            let ab = m(a, b, &mut pts);
+            let bc = m(b, c, &mut pts);
+            let ca = m(c, a, &mut pts);
+            nf.extend_from_slice(&[[a, ab, ca], [ab, b, bc], [ca, bc, c], [ab, bc, ca]]);
+        }
+        faces = nf;
+    }
+    let inward = faces.iter().map(|f| [f[0], f[2], f[1]]).collect();
+    (pts, inward)
+}
+
+#[test]
+fn fills_a_sphere_by_delaunay() {
+    let (pts, faces) = icosphere(2);
+    let f = fill_cavity(&pts, &faces, &FillOptions::default()).expect("fill");
+    verify(&pts, &faces, &f);
+}
+
+/// Schönhardt's twisted prism: no tetrahedralization without a Steiner
+/// point. Faces inward.
+fn schonhardt(twist: f64) -> (Vec<P3>, Vec<[u32; 3]>) {
+    let mut pts = Vec::new();
+    for k in 0..3 {
+        let a = k as f64 * 2.0943951023931953;
+        pts.push([a.cos(), a.sin(), 0.0]);
+    }
+    for k in 0..3 {
+        let a = k as f64 * 2.0943951023931953 + twist;
+        pts.push([a.cos(), a.sin(), 1.0]);
+    }
+    // Outward: bottom (0,2,1), top (3,4,5); each side quad split along
+    // the reflex diagonal.
+    let mut out = vec![[0, 2, 1], [3, 4, 5]];
+    for k in 0..3u32 {
+        let (a, b) = (k, (k + 1) % 3);
+        let (c, d) = (a + 3, b + 3);
+        out.push([a, b, d]);
+        out.push([a, d, c]);
+    }
+    let inward = out.iter().map(|f| [f[0], f[2], f[1]]).collect();
+    (pts, inward)
+}
+
+#[test]
+fn fills_schonhardt_with_a_steiner_point() {
+    let (pts, faces) = schonhardt(0.5);
+    let f = fill_cavity(&pts, &faces, &FillOptions::default()).expect("fill");
+    verify(&pts, &faces, &f);
+    assert!(!f.steiner.is_empty(), "Schönhardt needs a Steiner point");
+}
+
+/// A box with a slot cut into its top (not star-shaped), faces inward.
+fn slotted_box(gap: f64) -> (Vec<P3>, Vec<[u32; 3]>) {
+    // Profile in x-z (a U), extruded along y from 0 to 1.
+    let prof: Vec<[f64; 2]> = vec![
+        [0.0, 0.0],
+        [1.0, 0.0],
+        [1.0, 1.0],
+        [0.5 + gap / 2.0, 1.0],
+        [0.5 + gap / 2.0, 0.1],
+        [0.5 - gap / 2.0, 0.1],
+        [0.5 - gap / 2.0, 1.0],
+        [0.0, 1.0],
+    ];
+    let n = prof.len() as u32;
+    let mut pts: Vec<P3> = Vec::new();
+    for y in [0.0, 1.0] {
+        for p in &prof {
+            pts.push([p[0], y, p[1]]);
+        }
+    }
+    // The U's caps as triangles (ear pieces, counter-clockwise in x-z seen
+    // from -y): a fixed triangulation of this octagon.
+    let cap: Vec<[u32; 3]> = vec![
+        [0, 1, 4],
+        [0, 4, 5],
+        [1, 2, 3],
+        [1, 3, 4],
+        [0, 5, 6],
+        [0, 6, 7],
+    ];
+    let mut out: Vec<[u32; 3]> = Vec::new();
+    for c in &cap {
+        // y = 0 cap, outward normal -y.
+        out.push([c[0], c[1], c[2]]);
+        out.push([c[0] + n, c[2] + n, c[1] + n]);
+    }
+    for k in 0..n {
+        let (a, b) = (k, (k + 1) % n);
+        out.push([a, a + n, b + n]);
+        out.push([a, b + n, b]);
+    }
+    // Orient by the sign of the volume.
+    let o = pts[0];
+    let v: f64 = out
+        .iter()
+        .map(|f| {
+            orient3d(
+                pts[f[0] as usize],
+                pts[f[1] as usize],
+                pts[f[2] as usize],
+                o,
+            )
+        })
+        .sum();
+    let inward = if v > 0.0 {
+        out
+    } else {
+        out.iter().map(|f| [f[0], f[2], f[1]]).collect()
+    };
+    (pts, inward)
+}
+
+#[test]
+fn fills_a_slotted_box() {
+    for gap in [0.2, 1e-3] {
+        let (pts, faces) = slotted_box(gap);
+        let f = fill_cavity(&pts, &faces, &FillOptions::default()).expect("fill");
+        verify(&pts, &faces, &f);
+        assert_eq!(f.method, FillMethod::Delaunay);
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(32))]
+    /// Radially perturbed spheres are star-shaped about the origin.
+    #[test]
+    fn fills_random_star_shaped(radii in prop::collection::vec(0.2f64..1.0, 66), level in 1usize..3) {
+        let (mut pts, faces) = icosphere(level);
+        for (i, p) in pts.iter_mut().enumerate() {
+            let r = radii[i % radii.len()];
+            *p = p.map(|x| x * r);
+        }
+        let f = fill_cavity(&pts, &faces, &FillOptions::default()).expect("fill");
+        verify(&pts, &faces, &f);
+    }
+
+    /// A needle: a sphere squeezed to aspect ratios up to 5000.
+    #[test]
+    fn fills_needles(aspect in 10.0f64..5000.0, level in 1usize..3) {
+        let (mut pts, faces) = icosphere(level);
+        for p in pts.iter_mut() {
+            p[0] /= aspect;
+            p[1] /= aspect;
+        }
+        let f = fill_cavity(&pts, &faces, &FillOptions::default()).expect("fill");
+        verify(&pts, &faces, &f);
+    }
+}

@@ -1,0 +1,183 @@
+//! A stalled front hands its cavities to the constrained Delaunay fill
+//! (issue 20; `parafront_delaunay::fill_cavity`). Each cavity is a closed
+//! component of the live front; one the fill cannot close is grown by
+//! removing the tets behind its faces, a bounded number of times. The
+//! fills are computed in parallel and applied in cavity order, so the mesh
+//! does not depend on the thread count.
+use super::*;
+use parafront_delaunay::{fill_cavity, FillOptions};
+use rayon::prelude::*;
+
+impl<'a> Front<'a> {
+    /// Fill every cavity of the live front; `false` when one is left after
+    /// `fill_growth` growth rounds.
+    pub(super) fn fill_stalled(&mut self) -> bool {
+        let fopts = FillOptions::default();
+        for round in 0..=self.opts.fill_growth {
+            let comps = self.live_components();
+            if comps.is_empty() {
+                return true;
+            }
+            tracing::debug!(
+                round,
+                cavities = comps.len(),
+                "front stalled: constrained fill"
+            );
+            if let Some(p) = &self.opts.progress {
+                p.note_fill();
+            }
+            let cavities: Vec<(Vec<u32>, Vec<[u32; 3]>)> = comps
+                .iter()
+                .map(|c| {
+                    (
+                        c.clone(),
+                        c.iter().map(|&f| self.fv[f as usize].v).collect(),
+                    )
+                })
+                .collect();
+            let pts = &self.pts;
+            let fills: Vec<_> = cavities
+                .par_iter()
+                .map(|(_, faces)| fill_cavity(pts, faces, &fopts))
+                .collect();
+            let mut failed: Vec<u32> = Vec::new();
+            for ((ids, faces), fill) in cavities.iter().zip(fills) {
+                match fill {
+                    Ok(fill) => self.apply_fill(faces, fill),
+                    Err(e) => {
+                        tracing::debug!(faces = faces.len(), error = %e, "cavity not filled");
+                        failed.extend_from_slice(ids);
+                    }
+                }
+            }
+            if failed.is_empty() {
+                return true;
+            }
+            if round == self.opts.fill_growth {
+                break;
+            }
+            // Grow each cavity left by the tets behind its faces.
+            let mut grow: Vec<u32> = failed
+                .iter()
+                .filter(|&&f| self.fv[f as usize].alive)
+                .map(|&f| self.fv[f as usize].owner)
+                .filter(|&o| o != NONE)
+                .map(|o| o >> 2)
+                .collect();
+            grow.sort_unstable();
+            grow.dedup();
+            if grow.is_empty() {
+                break;
+            }
+            for &t in &grow {
+                self.talive[t as usize] = false;
+            }
+            for &t in &grow {
+                self.unlink_tet(t);
+            }
+            self.stats.tets_removed += grow.len();
+        }
+        self.stuck = (0..self.fv.len() as u32)
+            .filter(|&f| self.fv[f as usize].alive)
+            .collect();
+        false
+    }
+
+    /// The live faces in components joined by shared edges, each sorted,
+    /// in order of their smallest face id.
+    fn live_components(&mut self) -> Vec<Vec<u32>> {
+        let live: Vec<u32> = (0..self.fv.len() as u32)
+            .filter(|&f| self.fv[f as usize].alive)
+            .collect();
+        let mut by_edge: FxHashMap<(u32, u32), Vec<u32>> = FxHashMap::default();
+        for &f in &live {
+            let v = self.fv[f as usize].v;
+            for k in 0..3 {
+                let (a, b) = (v[k], v[(k + 1) % 3]);
+                by_edge.entry((a.min(b), a.max(b))).or_default().push(f);
+            }
+        }
+        let mut comp: FxHashMap<u32, usize> = FxHashMap::default();
+        let mut out: Vec<Vec<u32>> = Vec::new();
+        for &s in &live {
+            if comp.contains_key(&s) {
+                continue;
+            }
+            let c = out.len();
+            comp.insert(s, c);
+            let mut list = vec![s];
+            let mut i = 0;
+            while i < list.len() {
+                let f = list[i];
+                i += 1;
+                let v = self.fv[f as usize].v;
+                for k in 0..3 {
+                    let (a, b) = (v[k], v[(k + 1) % 3]);
+                    for &g in &by_edge[&(a.min(b), a.max(b))] {
+                        if let std::collections::hash_map::Entry::Vacant(e) = comp.entry(g) {
+                            e.insert(c);
+                            list.push(g);
+                        }
+                    }
+                }
+            }
+            list.sort_unstable();
+            out.push(list);
+        }
+        out
+    }
+
+    /// Add a fill's points and tets; each tet's faces close the front faces
+    /// they meet and open the others (AF5 on all four faces).
+    fn apply_fill(&mut self, faces: &[[u32; 3]], fill: parafront_delaunay::Fill) {
+        let n = self.pts.len() as u32;
+        let mut h = 0.0;
+        let mut k = 0usize;
+        for f in faces {
+            for &v in f {
+                h += self.hp[v as usize];
+                k += 1;
+            }
+        }
+        let h = h / k.max(1) as f64;
+        for &p in &fill.steiner {
+            self.pts.push(p);
+            self.hp.push(h);
+            self.stats.new_points += 1;
+        }
+        debug_assert!(fill
+            .tets
+            .iter()
+            .flatten()
+            .all(|&v| v < n + fill.steiner.len() as u32));
+        for &tv in &fill.tets {
+            self.add_tet(tv);
+        }
+        self.stats.cavities_filled += 1;
+        self.stats.fill_tets += fill.tets.len();
+    }
+
+    /// Add tet `tv`: each face matches a live front face (which leaves the
+    /// front, the two linked) or joins the front.
+    fn add_tet(&mut self, tv: [u32; 4]) {
+        let t = self.tets.len() as u32;
+        self.tets.push(tv);
+        self.talive.push(true);
+        self.neigh.extend_from_slice(&[NONE; 4]);
+        self.stats.tets += 1;
+        for i in 0..4 {
+            let w = TET_FACES[i].map(|k| tv[k]);
+            let fr = 4 * t + i as u32;
+            if let Some(g) = self.face_id(w) {
+                let o = self.fv[g as usize].owner;
+                self.neigh[fr as usize] = o;
+                if o != NONE {
+                    self.neigh[o as usize] = fr;
+                }
+                self.remove_face(g);
+            } else {
+                self.add_face(w, fr);
+            }
+        }
+    }
+}
