@@ -4,7 +4,7 @@
 //! A star-shaped cavity the recovery cannot close takes the cone from its
 //! kernel's deepest point instead. Every result is verified exactly.
 use crate::flips::key3;
-use crate::recover::recover_all;
+use crate::recover::{crossings, recover_all};
 use crate::tri::{InsertError, Triangulation, NONE, TET_FACES};
 use parafront_geom::{centroid3, kernel::deepest_point, orient3d, tri_normal, P3};
 use rustc_hash::{FxHashMap, FxHashSet};
@@ -16,13 +16,20 @@ pub struct FillOptions {
     pub max_steiner: usize,
     /// Flips tried on one missing face before it counts as stuck.
     pub flips_per_face: usize,
+    /// Triangulations tried, each under another symbolic perturbation.
+    pub attempts: usize,
+    /// Cavities with more faces get no Steiner points (their search is
+    /// slow, and growing them serves better).
+    pub max_steiner_faces: usize,
 }
 
 impl Default for FillOptions {
     fn default() -> Self {
         FillOptions {
-            max_steiner: 64,
-            flips_per_face: 64,
+            max_steiner: 16,
+            flips_per_face: 16,
+            attempts: 4,
+            max_steiner_faces: 200,
         }
     }
 }
@@ -59,7 +66,7 @@ pub enum FillError {
     BadIndex(usize, u32),
     #[error("cavity face {0} repeats a corner")]
     Degenerate(usize),
-    #[error("cavity edge {0}-{1} is not shared by exactly two faces of opposite directions")]
+    #[error("cavity edge {0}-{1} is not used as often in each direction")]
     NotClosed(u32, u32),
     #[error("the cavity's faces enclose no positive volume")]
     NotPositive,
@@ -84,6 +91,50 @@ pub fn fill_cavity(
     let mut local: Vec<u32> = faces.iter().flatten().copied().collect();
     local.sort_unstable();
     local.dedup();
+    let mut flips = 0;
+    let mut missing = 0;
+    let attempts = if faces.len() > opts.max_steiner_faces {
+        1
+    } else {
+        opts.attempts.max(1)
+    };
+    for attempt in 0..attempts {
+        if attempt > 0 {
+            // Another symbolic perturbation: on CAD's coplanar and
+            // cospherical points it picks other diagonals.
+            let key = |v: u32| {
+                (v as u64 ^ (attempt as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15))
+                    .wrapping_mul(0xff51_afd7_ed55_8ccd)
+            };
+            local.sort_unstable_by_key(|&v| key(v));
+        }
+        match delaunay_fill(points, faces, &local, opts, &mut flips)? {
+            Ok(f) => return Ok(f),
+            Err(m) => missing = m,
+        }
+        if attempt == 0 {
+            // Flips are stuck: a star-shaped cavity takes the cone.
+            if let Some(f) = cone(points, faces) {
+                return Ok(f);
+            }
+        }
+    }
+    Err(FillError::Unrecovered {
+        missing,
+        faces: faces.len(),
+    })
+}
+
+/// One try: the triangulation of the points `local` (in that order of
+/// ids), its faces recovered, Steiner points added while flips are stuck.
+/// The fill, or how many faces stayed missing.
+fn delaunay_fill(
+    points: &[P3],
+    faces: &[[u32; 3]],
+    local: &[u32],
+    opts: &FillOptions,
+    flips: &mut usize,
+) -> Result<Result<Fill, usize>, FillError> {
     let lp: Vec<P3> = local.iter().map(|&i| points[i as usize]).collect();
     let to_tri: FxHashMap<u32, u32> = local
         .iter()
@@ -92,61 +143,44 @@ pub fn fill_cavity(
         .collect();
     let cf: Vec<[u32; 3]> = faces.iter().map(|f| f.map(|v| to_tri[&v])).collect();
     let mut tri = Triangulation::new(&lp)?;
-    let mut flips = 0;
-    let mut steiner: Vec<u32> = Vec::new();
-    let mut tried_cone = false;
+    let mut steiner = 0;
     loop {
-        let missing = recover_all(&mut tri, &cf, opts.flips_per_face, &mut flips);
+        let missing = recover_all(&mut tri, &cf, opts.flips_per_face, flips);
         if missing.is_empty() {
             if let Some(kept) = classify(&tri, &cf) {
-                return Ok(output(
+                return Ok(Ok(output(
                     &tri,
                     &kept,
-                    &local,
+                    local,
                     points.len(),
                     FillMethod::Delaunay,
-                    flips,
-                ));
+                    *flips,
+                )));
             }
-        }
-        if std::env::var("DBG_FILL").is_ok() {
-            for &m in &missing {
-                let f = cf[m];
-                eprintln!("missing {:?} {:?}", f, f.map(|v| tri.pts[v as usize]));
-            }
-        }
-        // Flips are stuck: a star-shaped cavity takes the cone.
-        if !tried_cone {
-            tried_cone = true;
-            if let Some(f) = cone(points, faces) {
-                return Ok(f);
-            }
-        }
-        if steiner.len() >= opts.max_steiner || missing.is_empty() {
-            return Err(FillError::Unrecovered {
-                missing: missing.len().max(1),
-                faces: faces.len(),
-            });
+            return Ok(Err(1));
         }
         // Steiner points near the stuck faces, each strictly inside the
         // cavity and seeing the faces around it.
+        // Large cavities are grown by the caller rather than searched.
+        if cf.len() > opts.max_steiner_faces {
+            return Ok(Err(missing.len()));
+        }
         let mut added = false;
         for &m in missing.iter().take(4) {
-            if steiner.len() >= opts.max_steiner {
+            if steiner >= opts.max_steiner {
                 break;
             }
-            if let Some(q) = steiner_near(&tri, &cf, m) {
-                if let Ok(id) = tri.insert(q) {
-                    steiner.push(id);
+            if let Some(q) =
+                steiner_at_crossing(&tri, &cf, m).or_else(|| steiner_near(&tri, &cf, m))
+            {
+                if tri.insert(q).is_ok() {
+                    steiner += 1;
                     added = true;
                 }
             }
         }
         if !added {
-            return Err(FillError::Unrecovered {
-                missing: missing.len(),
-                faces: faces.len(),
-            });
+            return Ok(Err(missing.len()));
         }
     }
 }
@@ -169,8 +203,10 @@ fn validate(points: &[P3], faces: &[[u32; 3]]) -> Result<(), FillError> {
             *half.entry((a, b)).or_default() += 1;
         }
     }
+    // A pinched cavity (two parts touching along an edge) uses the edge
+    // twice each way.
     for (&(a, b), &n) in &half {
-        if n != 1 || half.get(&(b, a)) != Some(&1) {
+        if half.get(&(b, a)) != Some(&n) {
             return Err(FillError::NotClosed(a.min(b), a.max(b)));
         }
     }
@@ -404,4 +440,56 @@ fn inside(tri: &Triangulation, cf: &[[u32; 3]], q: P3) -> bool {
         return odd;
     }
     false
+}
+
+/// A point just inside stuck face `m` where the triangulation crosses it:
+/// an edge that pierces the face, or the face's edge where it pierces a
+/// face, moved off the face into the cavity (Si's Steiner points near a
+/// missing facet, kept off the surface). Inserted, it removes the crossing.
+fn steiner_at_crossing(tri: &Triangulation, cf: &[[u32; 3]], m: usize) -> Option<P3> {
+    use parafront_geom::{add, dist, normalize, scale, sub};
+    let f = cf[m];
+    let p = f.map(|v| tri.pts[v as usize]);
+    let n = normalize(tri_normal(p[0], p[1], p[2]));
+    let c = centroid3(p[0], p[1], p[2]);
+    let (edges, faces) = crossings(tri, f);
+    let mut hits: Vec<P3> = Vec::new();
+    for (u, v) in edges {
+        let (pu, pv) = (tri.pts[u as usize], tri.pts[v as usize]);
+        let (ou, ov) = (
+            orient3d(p[0], p[1], p[2], pu),
+            orient3d(p[0], p[1], p[2], pv),
+        );
+        if ou == ov {
+            continue;
+        }
+        let t = ou / (ou - ov);
+        hits.push(add(pu, scale(sub(pv, pu), t)));
+    }
+    for fr in faces {
+        let tv = tri.tet(fr >> 2);
+        let w = crate::tri::TET_FACES[(fr & 3) as usize].map(|k| tri.pts[tv[k] as usize]);
+        for e in 0..3 {
+            let (a, b) = (p[e], p[(e + 1) % 3]);
+            let (oa, ob) = (orient3d(w[0], w[1], w[2], a), orient3d(w[0], w[1], w[2], b));
+            if (oa > 0.0) != (ob > 0.0) && oa != 0.0 && ob != 0.0 {
+                let t = oa / (oa - ob);
+                // On the face's edge: pulled towards its centroid.
+                let x = add(a, scale(sub(b, a), t));
+                hits.push(add(x, scale(sub(c, x), 0.1)));
+            }
+        }
+    }
+    let lmin = (0..3)
+        .map(|e| dist(p[e], p[(e + 1) % 3]))
+        .fold(f64::INFINITY, f64::min);
+    for x in hits {
+        for s in [0.2, 0.05, 0.01] {
+            let q = add(x, scale(n, s * lmin));
+            if orient3d(p[0], p[1], p[2], q) > 0.0 && inside(tri, cf, q) {
+                return Some(q);
+            }
+        }
+    }
+    None
 }

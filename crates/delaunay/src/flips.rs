@@ -150,6 +150,40 @@ impl Triangulation {
     /// over the ring polygon joined to `p` and to `q` (a 3-2 flip for a
     /// ring of three, 4-4 for four). Every fan apex is tried.
     pub fn remove_edge(&mut self, p: u32, q: u32, protect: &FxHashSet<[u32; 3]>) -> Flip {
+        let r = self.remove_edge_fan(p, q, protect);
+        if r != Flip::NotConvex {
+            return r;
+        }
+        // No fan is positive: shrink the ring by 2-3 flips of the faces
+        // around the edge (each takes one corner out of the ring), then
+        // try the fan again (Shewchuk's edge removal by flips).
+        loop {
+            let Some((_, ring)) = self.edge_ring(p, q) else {
+                return Flip::NotApplicable;
+            };
+            if ring.len() <= 3 {
+                return self.remove_edge_fan(p, q, protect);
+            }
+            let mut shrunk = false;
+            for &r in &ring {
+                let Some(fr) = self.find_face([p, q, r]) else {
+                    continue;
+                };
+                if self.flip23(fr, protect) == Flip::Done {
+                    shrunk = true;
+                    break;
+                }
+            }
+            if !shrunk {
+                return Flip::NotConvex;
+            }
+            if self.remove_edge_fan(p, q, protect) == Flip::Done {
+                return Flip::Done;
+            }
+        }
+    }
+
+    fn remove_edge_fan(&mut self, p: u32, q: u32, protect: &FxHashSet<[u32; 3]>) -> Flip {
         let Some((tets, ring)) = self.edge_ring(p, q) else {
             return Flip::NotApplicable;
         };

@@ -24,7 +24,8 @@ pub(crate) fn recover_all(
             missing.push(i);
         }
     }
-    loop {
+    // A few passes: a face one pass recovers can unblock another.
+    for _ in 0..4 {
         let before = missing.len();
         let mut still = Vec::new();
         for &i in &missing {
@@ -36,9 +37,10 @@ pub(crate) fn recover_all(
         }
         missing = still;
         if missing.is_empty() || missing.len() == before {
-            return missing;
+            break;
         }
     }
+    missing
 }
 
 fn recover_face(
@@ -79,7 +81,7 @@ fn recover_face(
 /// The triangulation's edges that meet face `f` (outside its own edges),
 /// and its faces that an edge of `f` pierces, found among the tets near
 /// `f`.
-fn crossings(tri: &Triangulation, f: [u32; 3]) -> (Vec<(u32, u32)>, Vec<u32>) {
+pub(crate) fn crossings(tri: &Triangulation, f: [u32; 3]) -> (Vec<(u32, u32)>, Vec<u32>) {
     let p = f.map(|v| tri.pts[v as usize]);
     let mut lo = p[0];
     let mut hi = p[0];

@@ -10,10 +10,10 @@ use rayon::prelude::*;
 
 impl<'a> Front<'a> {
     /// Fill every cavity of the live front; `false` when one is left after
-    /// `fill_growth` growth rounds.
-    pub(super) fn fill_stalled(&mut self) -> bool {
+    /// `growth` growth rounds.
+    pub(super) fn fill_stalled(&mut self, growth: u32) -> bool {
         let fopts = FillOptions::default();
-        for round in 0..=self.opts.fill_growth {
+        for round in 0..=growth {
             let comps = self.live_components();
             if comps.is_empty() {
                 return true;
@@ -53,7 +53,7 @@ impl<'a> Front<'a> {
             if failed.is_empty() {
                 return true;
             }
-            if round == self.opts.fill_growth {
+            if round == growth {
                 break;
             }
             // Grow each cavity left by the tets behind its faces.

@@ -1,0 +1,61 @@
+//! Fill the cavity in an OBJ file (faces pointing into it) and report:
+//! `cargo run --example fill_obj -- CAVITY.obj`.
+use parafront_delaunay::{fill_cavity, FillOptions};
+use std::time::Instant;
+
+fn main() {
+    let path = std::env::args().nth(1).expect("usage: fill_obj CAVITY.obj");
+    let text = std::fs::read_to_string(&path).expect("read");
+    let (mut pts, mut faces) = (Vec::new(), Vec::new());
+    for l in text.lines() {
+        let w: Vec<&str> = l.split_whitespace().collect();
+        match w.first() {
+            Some(&"v") => pts.push([1, 2, 3].map(|k| w[k].parse::<f64>().expect("coordinate"))),
+            Some(&"f") => faces.push([1, 2, 3].map(|k| w[k].parse::<u32>().expect("index") - 1)),
+            _ => {}
+        }
+    }
+    // Faces that meet other than in shared corners (the cavity must be
+    // embedded).
+    let mut bad = 0;
+    for i in 0..faces.len() {
+        for j in i + 1..faces.len() {
+            let (a, b): ([u32; 3], [u32; 3]) = (faces[i], faces[j]);
+            let shared: Vec<u32> = a.iter().copied().filter(|v| b.contains(v)).collect();
+            let rot = |t: [u32; 3]| {
+                let mut r: Vec<u32> = shared.clone();
+                r.extend(t.iter().copied().filter(|v| !shared.contains(v)));
+                [r[0], r[1], r[2]]
+            };
+            let (ra, rb) = (rot(a), rot(b));
+            let pa = ra.map(|v| pts[v as usize]);
+            let pb = rb.map(|v| pts[v as usize]);
+            if shared.len() < 3
+                && parafront_geom::intersect::triangles_intersect(pa, pb, shared.len())
+            {
+                bad += 1;
+                if bad < 5 {
+                    println!("faces {i} {a:?} and {j} {b:?} meet");
+                }
+            }
+        }
+    }
+    println!("{bad} pairs of faces meet");
+    let t0 = Instant::now();
+    match fill_cavity(&pts, &faces, &FillOptions::default()) {
+        Ok(f) => println!(
+            "{path}: {} faces: {} tets, {} Steiner points, {:?}, {} flips, {:.3} s",
+            faces.len(),
+            f.tets.len(),
+            f.steiner.len(),
+            f.method,
+            f.flips,
+            t0.elapsed().as_secs_f64()
+        ),
+        Err(e) => println!(
+            "{path}: {} faces: {e} ({:.3} s)",
+            faces.len(),
+            t0.elapsed().as_secs_f64()
+        ),
+    }
+}
