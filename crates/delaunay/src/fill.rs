@@ -27,8 +27,8 @@ impl Default for FillOptions {
     fn default() -> Self {
         FillOptions {
             max_steiner: 16,
-            flips_per_face: 16,
-            attempts: 4,
+            flips_per_face: 32,
+            attempts: 6,
             max_steiner_faces: 200,
         }
     }

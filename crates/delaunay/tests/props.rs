@@ -333,3 +333,27 @@ proptest! {
         verify(&pts, &faces, &f);
     }
 }
+
+fn read_obj(text: &str) -> (Vec<P3>, Vec<[u32; 3]>) {
+    let (mut pts, mut faces) = (Vec::new(), Vec::new());
+    for l in text.lines() {
+        let w: Vec<&str> = l.split_whitespace().collect();
+        match w.first() {
+            Some(&"v") => pts.push([1, 2, 3].map(|k| w[k].parse::<f64>().unwrap())),
+            Some(&"f") => faces.push([1, 2, 3].map(|k| w[k].parse::<u32>().unwrap() - 1)),
+            _ => {}
+        }
+    }
+    (pts, faces)
+}
+
+/// A thin twisted cavity left by the front on round.stl (10 points on a
+/// cylinder, two z levels): flips recover 14 of its 16 faces, and no
+/// interior Steiner point tried so far unblocks the other two.
+#[test]
+#[ignore = "issue 20: open; the fill's face recovery is not strong enough yet"]
+fn fills_the_round_stl_cavity() {
+    let (pts, faces) = read_obj(include_str!("data/round_stl_cavity.obj"));
+    let f = fill_cavity(&pts, &faces, &FillOptions::default()).expect("fill");
+    verify(&pts, &faces, &f);
+}
