@@ -87,11 +87,6 @@ pub struct FrontOptions {
     /// (issue 20) instead of failing. Off, the front stops with
     /// `FrontError::Stuck` where the fill would start.
     pub fill: bool,
-    /// Recovery rounds without fewer stuck faces before the fill is tried
-    /// (once; it is tried again, with growth, before the front gives up).
-    pub fill_stall_rounds: u32,
-    /// Recovery rounds after which the fill starts in any case.
-    pub fill_after_rounds: u32,
     /// Times a cavity the fill cannot close is grown by the tets behind
     /// its faces before the front gives up.
     pub fill_growth: u32,
@@ -109,8 +104,6 @@ impl Default for FrontOptions {
             keep_partial: false,
             max_growth: MAX_GROWTH_PER_TET,
             fill: true,
-            fill_stall_rounds: 3,
-            fill_after_rounds: 12,
             fill_growth: 4,
         }
     }
@@ -792,7 +785,6 @@ impl<'a> Front<'a> {
     fn run(&mut self) -> Result<(), FrontError> {
         let mut fewest_stuck = usize::MAX;
         let mut last_gain = 0;
-        let mut next_fill = 0;
         loop {
             while let Some(e) = self.heap.pop() {
                 let (key, fid) = (f32::from_bits((e >> 32) as u32) as f64, e as u32);
@@ -838,18 +830,10 @@ impl<'a> Front<'a> {
             }
             let give_up =
                 self.relax >= self.opts.recovery_rounds || self.relax >= last_gain + STALL_ROUNDS;
-            let stalled = self.relax >= last_gain + self.opts.fill_stall_rounds
-                || self.relax >= self.opts.fill_after_rounds;
-            if self.opts.fill && (give_up || (stalled && self.relax >= next_fill)) {
-                // Before giving up the fill may grow its cavities; a
-                // stall only tries them as they are, then recovery goes on.
-                let growth = if give_up { self.opts.fill_growth } else { 0 };
-                if self.fill_stalled(growth) {
-                    continue;
-                }
-                // Once per run before giving up: a failed fill costs as
-                // much as several recovery rounds.
-                next_fill = u32::MAX;
+            // The fill is the last resort, where the front would give up:
+            // fronts that recovery closes keep their meshes.
+            if self.opts.fill && give_up && self.fill_stalled(self.opts.fill_growth) {
+                continue;
             }
             if give_up {
                 return Err(self.stuck_error());
