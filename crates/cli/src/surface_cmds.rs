@@ -53,6 +53,9 @@ impl HealTol {
 /// surface when asked, once it validates (the mesher reports it if not).
 pub fn heal_for_mesh(s: Surface, a: &HealArgs, w: &WriteArgs) -> Result<Surface, Fail> {
     if !a.heal {
+        if a.tol.heal_tol.is_some() {
+            return Err(Fail(2, "--heal-tol needs --heal".into()));
+        }
         return Ok(s);
     }
     let h = heal(&s, &a.tol.options()?);
