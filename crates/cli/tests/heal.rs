@@ -41,8 +41,7 @@ fn dirty(s: &Surface) -> Surface {
         if !right(t) {
             continue;
         }
-        for k in 0..3 {
-            let v = t[k];
+        for (k, &v) in t.iter().enumerate() {
             let shared = s.tris.iter().any(|u| !right(u) && u.contains(&v));
             if shared {
                 let c = *copy.entry(v).or_insert_with(|| {

@@ -538,6 +538,14 @@ pub fn check(input: &Surface, h: &Healed, opts: &HealOptions) -> Result<(), Stri
             r.vertices_merged
         ));
     }
+    if input
+        .tris
+        .iter()
+        .flatten()
+        .any(|&v| v as usize >= map.len())
+    {
+        return Err("an input triangle names a point out of range".into());
+    }
     let mut shortest = vec![f64::INFINITY; input.points.len()];
     for t in &input.tris {
         for k in 0..3 {
