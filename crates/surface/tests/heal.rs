@@ -323,3 +323,43 @@ fn corpus_dirty_files_heal_to_valid_surfaces() {
         assert!(!r.is_valid(), "{file} healed to valid");
     }
 }
+
+#[test]
+fn random_seams_on_a_torus_close_back_exactly() {
+    use parafront_surface::generate::torus;
+    let s = torus([1.0, -2.0, 0.5], 3.0, 0.75, 24, 12);
+    assert!(validate(&s).is_valid());
+    // A small LCG: seams along random planes, each copy 1 to 3 ulps off
+    // along each axis, up or down.
+    let mut seed = 0x2545_f491_4f6c_dd1du64;
+    let mut next = move || {
+        seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        seed >> 33
+    };
+    for _ in 0..8 {
+        let (a, b) = (next() % 7, next() % 5);
+        let side = |t: &[u32; 3]| {
+            let c = t.map(|v| s.points[v as usize]);
+            let x: f64 = c
+                .iter()
+                .map(|p| p[0] * (a as f64 - 3.0) + p[1] * (b as f64 - 2.0))
+                .sum();
+            x > 0.0
+        };
+        let steps: Vec<i64> = (0..3).map(|_| (next() % 7) as i64 - 3).collect();
+        let jitter = |p: P3| {
+            let mut q = p;
+            for k in 0..3 {
+                let bits = q[k].to_bits() as i64 + steps[k];
+                q[k] = f64::from_bits(bits as u64);
+            }
+            q
+        };
+        let d = unweld(&s, side, jitter, |_| false);
+        let h = healed(&d, &HealOptions::default());
+        assert_eq!(h.report.vertices_merged, d.points.len() - s.points.len());
+        assert_eq!(h.surface, s, "steps {steps:?}");
+    }
+}
