@@ -2,6 +2,7 @@
 //! flags into the library's option structs and calls one function.
 mod parallel;
 mod plot;
+mod surface_cmds;
 
 use clap::{Args, Parser, Subcommand};
 use parafront_io::{read_mesh, write_mesh, MshVersion, WriteOptions};
@@ -13,6 +14,7 @@ use parafront_surface::Surface;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
+use surface_cmds::{HealArgs, HealTol};
 
 #[derive(Parser)]
 #[command(
@@ -49,6 +51,19 @@ enum Cmd {
         output: PathBuf,
         #[command(flatten)]
         mesh: MeshArgs,
+        #[command(flatten)]
+        heal: HealArgs,
+        #[command(flatten)]
+        write: WriteArgs,
+    },
+    /// Heal a surface that a float rounding left open (see `mesh --heal`)
+    /// and write it (.stl, .obj, .off, .msh, .mesh, .vtu); nothing is
+    /// written, exit 1, when it is still not valid.
+    Heal {
+        input: PathBuf,
+        output: PathBuf,
+        #[command(flatten)]
+        tol: HealTol,
         #[command(flatten)]
         write: WriteArgs,
     },
@@ -87,7 +102,9 @@ enum Cmd {
         #[arg(long)]
         ddg_passes: Option<usize>,
     },
-    /// Convert a tet mesh between formats (.vtu, .msh, .mesh).
+    /// Convert a tet mesh (.vtu, .msh, .mesh) or a surface (.stl, .obj,
+    /// .off, .msh, .mesh; patch tags kept where the format holds them).
+    /// A tet mesh written as .stl, .obj or .off gives its boundary.
     Convert {
         input: PathBuf,
         output: PathBuf,
@@ -160,7 +177,7 @@ struct MeshArgs {
 }
 
 #[derive(Args)]
-struct WriteArgs {
+pub(crate) struct WriteArgs {
     /// Gmsh output version: 4.1 or 2.2.
     #[arg(long, default_value = "4.1")]
     msh_version: String,
@@ -174,7 +191,7 @@ struct WriteArgs {
 
 /// A failure with its exit status: 1 for a bad surface or mesh, 2 for
 /// unreadable input and bad options.
-struct Fail(u8, String);
+pub(crate) struct Fail(pub(crate) u8, pub(crate) String);
 
 impl<E: std::fmt::Display> From<E> for Fail {
     fn from(e: E) -> Fail {
@@ -229,10 +246,18 @@ fn main() -> ExitCode {
             surface,
             output,
             mesh,
+            heal,
             write,
         } => read_surface(&surface)
             .map_err(Fail::from)
+            .and_then(|s| surface_cmds::heal_for_mesh(s, &heal, &write))
             .and_then(|s| run_mesh(&s, &surface.display().to_string(), &output, &mesh, &write)),
+        Cmd::Heal {
+            input,
+            output,
+            tol,
+            write,
+        } => surface_cmds::run_heal(&input, &output, &tol, &write),
         Cmd::Check { surface } => run_check(&surface),
         Cmd::Bench {
             surface,
@@ -249,7 +274,7 @@ fn main() -> ExitCode {
             input,
             output,
             write,
-        } => run_convert(&input, &output, &write),
+        } => surface_cmds::run_convert(&input, &output, &write),
     };
     match res {
         Ok(()) => ExitCode::SUCCESS,
@@ -260,7 +285,7 @@ fn main() -> ExitCode {
     }
 }
 
-fn write_options(w: &WriteArgs, s: Option<&Surface>) -> Result<WriteOptions, Fail> {
+pub(crate) fn write_options(w: &WriteArgs, s: Option<&Surface>) -> Result<WriteOptions, Fail> {
     let msh_version = match w.msh_version.as_str() {
         "4.1" | "4" => MshVersion::V41,
         "2.2" | "2" => MshVersion::V22,
@@ -598,6 +623,9 @@ fn run_check(path: &Path) -> Result<(), Fail> {
     let s = read_surface(path)?;
     let report = validate(&s);
     println!("{}: {}", path.display(), report);
+    if let Some(note) = surface_cmds::heal_hint(path, &s, &report) {
+        println!("{note}");
+    }
     let bodies = parafront_pipeline::bodies_in_material(&report.shells).len();
     if bodies > 0 && report.is_valid() {
         println!(
@@ -651,19 +679,5 @@ fn run_quality(path: &Path, plot_to: Option<&Path>, before: Option<&Path>) -> Re
         plot::plot_histograms(&q, qb.as_ref(), p)?;
         println!("wrote {}", p.display());
     }
-    Ok(())
-}
-
-fn run_convert(input: &Path, output: &Path, w: &WriteArgs) -> Result<(), Fail> {
-    let mesh = read_mesh(input)?;
-    write_mesh(output, &mesh, &write_options(w, None)?)?;
-    println!(
-        "{} -> {}: {} points, {} tets, {} boundary triangles",
-        input.display(),
-        output.display(),
-        mesh.points.len(),
-        mesh.tets.len(),
-        mesh.bnd_tris.len()
-    );
     Ok(())
 }

@@ -6,22 +6,27 @@
 //! - [`write_vtu`] / [`write_pvtu`]: VTU with extra point / cell arrays, and
 //!   one `.vtu` per part under a `.pvtu`.
 //! - [`read_mesh`]: `.vtu`, `.msh`, `.mesh` back into a [`TetMesh`].
+//! - [`write_surface`]: a triangle surface as STL, OBJ, OFF, `.msh`,
+//!   `.mesh` or `.vtu`, patch tags kept where the format holds them.
 //!
 //! Every writer is atomic ([`write_atomic`]): a temp file beside the target,
 //! renamed when complete. Tets and boundary triangles keep their order;
 //! regions and patch tags travel as VTU `region`/`patch` cell data, Gmsh
-//! physical tags (verbatim, 0 included) and Medit refs.
+//! named physical groups (from 1: tags shifted by 1 when one is 0) and
+//! Medit refs.
 
 mod atomic;
 mod medit;
 mod msh;
 mod read;
+mod surface;
 mod util;
 mod vtu;
 mod vtu_read;
 
 pub use atomic::write_atomic;
 pub use read::read_mesh;
+pub use surface::{surface_format, write_surface, SurfaceFormat};
 pub use vtu::{write_pvtu, write_vtu, Field, FieldData, Piece};
 
 use parafront_mesh::TetMesh;

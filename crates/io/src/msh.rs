@@ -1,17 +1,20 @@
 //! Gmsh `.msh` writers, versions 4.1 and 2.2, ascii and binary.
 //!
 //! Tets carry their region as physical tag, boundary triangles their patch
-//! tag, both verbatim (0 included). Entities: one volume per region and one
-//! surface per patch, the entity tag equal to the physical tag, so readers
-//! that fall back to the entity tag when the physical tag is 0 (Gmsh's
-//! "no physical group") still get the region back. Element tags are
-//! the tet index + 1, then `ntets` + triangle index + 1, so a reader that
-//! orders by tag recovers the input order.
+//! tag. Gmsh reads physical tag 0 as "no group", so groups start at 1:
+//! tags are written verbatim when they are all at least 1, and all shifted
+//! by 1 (per dimension) when one of them is 0. Every group gets a name in
+//! `$PhysicalNames`: the one given in [`WriteOptions`], else `region N` /
+//! `patch N` with N the tag before the shift. Entities: one volume per
+//! region and one surface per patch, the entity tag equal to the physical
+//! tag. Element tags are the tet index + 1, then `ntets` + triangle index
+//! + 1, so a reader that orders by tag recovers the input order.
 
 use crate::util::{check_mesh, put_f64, put_int, write_par};
 use crate::{write_atomic, IoError, MshVersion, WriteOptions};
 use parafront_geom::Aabb;
 use parafront_mesh::{PointId, TetMesh};
+use std::borrow::Cow;
 use std::io::Write;
 use std::path::Path;
 
@@ -49,9 +52,11 @@ fn groups<const N: usize>(m: &TetMesh, cells: &[[PointId; N]], tags: &[u32]) -> 
 /// Writes `mesh` as Gmsh `.msh` in the version and encoding of `opts`.
 pub fn write_msh(path: &Path, m: &TetMesh, opts: &WriteOptions) -> Result<(), IoError> {
     check_mesh(path, m)?;
-    if m.region
+    let (region, rshift) = physical_tags(&m.region);
+    let (patch, pshift) = physical_tags(&m.bnd_patch);
+    if region
         .iter()
-        .chain(&m.bnd_patch)
+        .chain(patch.iter())
         .any(|&t| t > i32::MAX as u32)
     {
         return Err(IoError::BadInput {
@@ -59,6 +64,15 @@ pub fn write_msh(path: &Path, m: &TetMesh, opts: &WriteOptions) -> Result<(), Io
             msg: "a region or patch tag does not fit Gmsh's int tags".into(),
         });
     }
+    let names = group_names(&m.bnd_patch, pshift, &opts.patch_names, "patch")
+        .into_iter()
+        .map(|(t, n)| (2, t, n))
+        .chain(
+            group_names(&m.region, rshift, &opts.region_names, "region")
+                .into_iter()
+                .map(|(t, n)| (3, t, n)),
+        )
+        .collect::<Vec<_>>();
     let b = opts.binary;
     write_atomic(path, |w| {
         let v = match opts.msh_version {
@@ -71,29 +85,57 @@ pub fn write_msh(path: &Path, m: &TetMesh, opts: &WriteOptions) -> Result<(), Io
             writeln!(w)?;
         }
         writeln!(w, "$EndMeshFormat")?;
-        physical_names(w, opts)?;
+        physical_names(w, &names)?;
         match opts.msh_version {
-            MshVersion::V41 => v41(w, m, b),
-            MshVersion::V22 => v22(w, m, b),
+            MshVersion::V41 => v41(w, m, &region, &patch, b),
+            MshVersion::V22 => v22(w, m, &region, &patch, b),
         }
     })
 }
 
-fn physical_names(w: &mut impl Write, opts: &WriteOptions) -> std::io::Result<()> {
-    let n = opts.region_names.len() + opts.patch_names.len();
-    if n == 0 {
+/// The tags as Gmsh physical tags: shifted by 1 when one of them is 0.
+fn physical_tags(tags: &[u32]) -> (Cow<'_, [u32]>, u32) {
+    if tags.contains(&0) {
+        (tags.iter().map(|&t| t.saturating_add(1)).collect(), 1)
+    } else {
+        (Cow::Borrowed(tags), 0)
+    }
+}
+
+/// (physical tag, name) of every tag used: the given name, else
+/// `{kind} {tag}` with the tag before the shift.
+fn group_names(
+    tags: &[u32],
+    shift: u32,
+    given: &[(u32, String)],
+    kind: &str,
+) -> Vec<(u32, String)> {
+    let mut used = tags.to_vec();
+    used.sort_unstable();
+    used.dedup();
+    used.iter()
+        .map(|&t| {
+            let name = given
+                .iter()
+                .find(|(g, _)| *g == t)
+                .map_or_else(|| format!("{kind} {t}"), |(_, n)| n.clone());
+            (t.saturating_add(shift), name)
+        })
+        .collect()
+}
+
+fn physical_names(w: &mut impl Write, names: &[(i32, u32, String)]) -> std::io::Result<()> {
+    if names.is_empty() {
         return Ok(());
     }
-    writeln!(w, "$PhysicalNames\n{n}")?;
-    for (dim, names) in [(2, &opts.patch_names), (3, &opts.region_names)] {
-        for (tag, name) in names.iter() {
-            // Names are quoted and end at the line: drop what would break them.
-            let clean: String = name
-                .chars()
-                .filter(|c| *c != '"' && *c != '\n' && *c != '\r')
-                .collect();
-            writeln!(w, "{dim} {tag} \"{clean}\"")?;
-        }
+    writeln!(w, "$PhysicalNames\n{}", names.len())?;
+    for (dim, tag, name) in names {
+        // Names are quoted and end at the line: drop what would break them.
+        let clean: String = name
+            .chars()
+            .filter(|c| *c != '"' && *c != '\n' && *c != '\r')
+            .collect();
+        writeln!(w, "{dim} {tag} \"{clean}\"")?;
     }
     writeln!(w, "$EndPhysicalNames")
 }
@@ -108,9 +150,15 @@ fn dbl(w: &mut impl Write, x: f64) -> std::io::Result<()> {
     w.write_all(&x.to_le_bytes())
 }
 
-fn v41(w: &mut impl Write, m: &TetMesh, b: bool) -> std::io::Result<()> {
-    let vols = groups(m, &m.tets, &m.region);
-    let surfs = groups(m, &m.bnd_tris, &m.bnd_patch);
+fn v41(
+    w: &mut impl Write,
+    m: &TetMesh,
+    region: &[u32],
+    patch: &[u32],
+    b: bool,
+) -> std::io::Result<()> {
+    let vols = groups(m, &m.tets, region);
+    let surfs = groups(m, &m.bnd_tris, patch);
     // $Entities: no points or curves; a bounding box per entity.
     writeln!(w, "$Entities")?;
     if b {
@@ -260,7 +308,13 @@ fn coords(buf: &mut Vec<u8>, p: [f64; 3]) {
     buf.push(b'\n');
 }
 
-fn v22(w: &mut impl Write, m: &TetMesh, b: bool) -> std::io::Result<()> {
+fn v22(
+    w: &mut impl Write,
+    m: &TetMesh,
+    region: &[u32],
+    patch: &[u32],
+    b: bool,
+) -> std::io::Result<()> {
     let np = m.points.len();
     writeln!(w, "$Nodes\n{np}")?;
     if b {
@@ -287,9 +341,9 @@ fn v22(w: &mut impl Write, m: &TetMesh, b: bool) -> std::io::Result<()> {
             continue;
         }
         let (etype, base, tags) = if dim == 3 {
-            (4, 0, &m.region)
+            (4, 0, region)
         } else {
-            (2, nt, &m.bnd_patch)
+            (2, nt, patch)
         };
         if b {
             for x in [etype, n as i32, 2] {

@@ -4,8 +4,11 @@
 //! - [`read`]: the format readers (STL, OBJ, OFF, Gmsh .msh, Medit .mesh).
 //! - [`validate`]: open / non-manifold / orientation / degenerate /
 //!   self-intersection checks, and how the closed shells nest.
+//! - [`heal`]: merges the vertices a float rounding split apart, where
+//!   that closes open edges (opt-in; exact welding stays the default).
 
 pub mod generate;
+pub mod heal;
 pub mod read;
 pub mod validate;
 

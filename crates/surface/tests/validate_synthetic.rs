@@ -491,8 +491,17 @@ fn bad_input_does_not_panic() {
     assert_eq!(classes(&r), vec![Class::NonFinite]);
     assert_eq!(r.count(Class::NonFinite), 1);
 
+    // An empty surface, or points without triangles (an OBJ cut short),
+    // is its own error, not a valid surface with nothing in it.
     let r = validate(&Surface::default());
-    assert!(r.is_valid() && r.shells.is_empty());
+    assert_eq!(classes(&r), vec![Class::NoTriangles]);
+    assert!(!r.is_valid() && r.shells.is_empty());
+    let mut s = cube([0.0; 3], 1.0);
+    s.tris.clear();
+    s.patch.clear();
+    let r = validate(&s);
+    assert_eq!(classes(&r), vec![Class::NoTriangles]);
+    assert!(r.to_string().contains("8 points and no triangles"), "{r}");
 }
 
 #[test]

@@ -172,3 +172,16 @@ pub fn python(script: &str, args: &[&str]) -> String {
     );
     String::from_utf8_lossy(&out.stdout).into_owned()
 }
+
+/// `m` with its tags as the Gmsh writer writes them: per kind, shifted by
+/// 1 when one of them is 0 (Gmsh groups start at 1).
+pub fn gmsh_tags(m: &TetMesh) -> TetMesh {
+    let shift = |t: &[u32]| -> Vec<u32> {
+        let s = t.contains(&0) as u32;
+        t.iter().map(|&x| x + s).collect()
+    };
+    let mut g = m.clone();
+    g.region = shift(&m.region);
+    g.bnd_patch = shift(&m.bnd_patch);
+    g
+}

@@ -24,6 +24,9 @@ pub const MAX_EXAMPLES: usize = 10;
 /// A class of surface defect.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum Class {
+    /// The surface has no triangles at all (an empty file, or one cut
+    /// short after its points).
+    NoTriangles,
     /// A triangle names a vertex id past the end of the point list.
     BadIndex,
     /// A referenced point has a NaN or infinite coordinate.
@@ -56,6 +59,7 @@ impl Class {
     }
     pub fn describe(self) -> &'static str {
         match self {
+            Class::NoTriangles => "no triangles (the file has points only, or nothing)",
             Class::BadIndex => "triangles with a vertex id out of range",
             Class::NonFinite => "points with a NaN or infinite coordinate",
             Class::OpenEdge => "open (boundary) edges, used by one triangle",
@@ -161,6 +165,10 @@ pub fn validate(s: &Surface) -> Report {
         shells: Vec::new(),
     };
     let np = s.points.len();
+    if s.tris.is_empty() {
+        r.push(Class::NoTriangles, 1, Vec::new());
+        return r;
+    }
     let bad: Vec<u32> = (0..s.tris.len() as u32)
         .filter(|&t| s.tris[t as usize].iter().any(|&v| v as usize >= np))
         .collect();
@@ -372,6 +380,14 @@ impl fmt::Display for Report {
             writeln!(f, "INVALID: {} problem classes", errors)?;
         }
         for p in &self.problems {
+            if p.class == Class::NoTriangles {
+                writeln!(
+                    f,
+                    "  no triangles: the file has {} points and no triangles, so nothing to mesh",
+                    self.n_points
+                )?;
+                continue;
+            }
             writeln!(f, "  {}: {}", p.class.describe(), p.count)?;
             for e in &p.examples {
                 writeln!(f, "    {}", e)?;
