@@ -159,12 +159,11 @@ fn delaunay_fill(
             }
             return Ok(Err(1));
         }
-        // Steiner points near the stuck faces, each strictly inside the
-        // cavity and seeing the faces around it.
         // Large cavities are grown by the caller rather than searched.
         if cf.len() > opts.max_steiner_faces {
             return Ok(Err(missing.len()));
         }
+        // Steiner points near the stuck faces, strictly inside the cavity.
         let mut added = false;
         for &m in missing.iter().take(4) {
             if steiner >= opts.max_steiner {

@@ -24,5 +24,4 @@ mod tri;
 pub use check::CheckError;
 pub use fill::{fill_cavity, Fill, FillError, FillMethod, FillOptions};
 pub use flips::Flip;
-pub use predicates::in_sphere;
 pub use tri::{InsertError, Triangulation, NONE, TET_FACES};

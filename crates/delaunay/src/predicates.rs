@@ -1,25 +1,6 @@
-//! The in-sphere test, exact (`robust`) and symbolically perturbed.
-use parafront_geom::{orient3d, P3};
-use robust::Coord3D;
-
-#[inline(always)]
-fn c3(p: P3) -> Coord3D<f64> {
-    Coord3D {
-        x: p[0],
-        y: p[1],
-        z: p[2],
-    }
-}
-
-/// Positive when `e` lies strictly inside the sphere through the corners of
-/// the positively oriented tet `abcd` (parafront's convention), negative
-/// outside, zero on it. Exact.
-#[inline]
-pub fn in_sphere(a: P3, b: P3, c: P3, d: P3, e: P3) -> f64 {
-    // `robust` wants Shewchuk's positive orientation, parafront's negative:
-    // swapping two corners turns one into the other.
-    robust::insphere(c3(b), c3(a), c3(c), c3(d), c3(e))
-}
+//! The in-sphere test under a symbolic perturbation (the exact test is
+//! `parafront_geom::in_sphere`).
+use parafront_geom::{in_sphere, orient3d, P3};
 
 /// Whether point `e` (id `ie`) is inside the circumsphere of the positive
 /// tet with ids `t` and points `p`, under a symbolic perturbation: a point

@@ -55,9 +55,9 @@ impl Triangulation {
         Ok(t)
     }
 
-    /// Only the bounding tet of `points`, with the points stored but not
-    /// inserted (ids `4..`): `insert_id` adds them one at a time.
-    pub fn bounding(points: &[P3]) -> Result<Triangulation, InsertError> {
+    /// Only the bounding tet of `points`, with the points stored (ids
+    /// `4..`) but not inserted yet.
+    fn bounding(points: &[P3]) -> Result<Triangulation, InsertError> {
         if let Some(p) = points.iter().find(|p| !p.iter().all(|x| x.is_finite())) {
             return Err(InsertError::NotFinite(*p));
         }
@@ -251,7 +251,7 @@ impl Triangulation {
             }
         }
         self.star_cavity(id, &mut cav, ep)?;
-        self.replace_by_cones(id, &cav, ep, None);
+        self.replace_by_cones(id, &cav, ep);
         self.conflict = cav;
         Ok(())
     }
@@ -297,15 +297,8 @@ impl Triangulation {
     }
 
     /// Replace the cavity `cav` (marked `ep`, star-shaped about point `id`)
-    /// by the cones from `id` over its boundary faces. `kept`, when given,
-    /// collects the new tets.
-    pub(crate) fn replace_by_cones(
-        &mut self,
-        id: u32,
-        cav: &[u32],
-        ep: u32,
-        mut kept: Option<&mut Vec<u32>>,
-    ) {
+    /// by the cones from `id` over its boundary faces.
+    pub(crate) fn replace_by_cones(&mut self, id: u32, cav: &[u32], ep: u32) {
         // Boundary faces: (outer face ref or NONE, the face's corners as
         // seen from the cavity, outward).
         let mut bnd: Vec<(u32, [u32; 3])> = Vec::new();
@@ -329,9 +322,6 @@ impl Triangulation {
             // positive, its face 3 is w reversed... i.e. w itself outward.
             let tv = [w[0], w[2], w[1], id];
             let t = self.new_tet(tv);
-            if let Some(k) = kept.as_deref_mut() {
-                k.push(t);
-            }
             self.neigh[4 * t as usize + 3] = nb;
             if nb != NONE {
                 self.neigh[nb as usize] = 4 * t + 3;

@@ -10,7 +10,7 @@ pub mod predicates;
 pub mod vec3;
 
 pub use aabb::Aabb;
-pub use predicates::{orient2d, orient3d, orient3d_sign, Sign};
+pub use predicates::{in_sphere, orient2d, orient3d, orient3d_sign, Sign};
 pub use vec3::*;
 
 /// A point in space. Plain arrays keep the struct-of-arrays stores compact.

@@ -36,6 +36,16 @@ fn c3(p: P3) -> Coord3D<f64> {
     }
 }
 
+/// Positive when `e` lies strictly inside the sphere through the corners of
+/// the positively oriented tet `abcd` (parafront's convention), negative
+/// outside, zero on it. Exact.
+#[inline]
+pub fn in_sphere(a: P3, b: P3, c: P3, d: P3, e: P3) -> f64 {
+    // `robust` wants Shewchuk's positive orientation, parafront's negative:
+    // swapping two corners turns one into the other.
+    robust::insphere(c3(b), c3(a), c3(c), c3(d), c3(e))
+}
+
 /// Exact sign of six times the volume of tet `abcd` (positive = right-handed).
 /// The value is not the volume; only its sign is exact.
 #[inline]

@@ -413,14 +413,7 @@ impl<'a> Front<'a> {
             .copied()
             .filter(|&f| self.fv[f as usize].alive)
             .collect();
-        let mut by_edge: FxHashMap<(u32, u32), Vec<u32>> = FxHashMap::default();
-        for &f in &live {
-            let v = self.fv[f as usize].v;
-            for k in 0..3 {
-                let (a, b) = (v[k], v[(k + 1) % 3]);
-                by_edge.entry((a.min(b), a.max(b))).or_default().push(f);
-            }
-        }
+        let by_edge = self.faces_by_edge(&live);
         for &seed in live.iter().take(MAX_PATCH_SEEDS) {
             let mut patch = vec![seed];
             let mut i = 0;

@@ -26,22 +26,17 @@ impl<'a> Front<'a> {
             if let Some(p) = &self.opts.progress {
                 p.note_fill();
             }
-            let cavities: Vec<(Vec<u32>, Vec<[u32; 3]>)> = comps
+            let cavities: Vec<Vec<[u32; 3]>> = comps
                 .iter()
-                .map(|c| {
-                    (
-                        c.clone(),
-                        c.iter().map(|&f| self.fv[f as usize].v).collect(),
-                    )
-                })
+                .map(|c| c.iter().map(|&f| self.fv[f as usize].v).collect())
                 .collect();
             let pts = &self.pts;
             let fills: Vec<_> = cavities
                 .par_iter()
-                .map(|(_, faces)| fill_cavity(pts, faces, &fopts))
+                .map(|faces| fill_cavity(pts, faces, &fopts))
                 .collect();
             let mut failed: Vec<u32> = Vec::new();
-            for ((ids, faces), fill) in cavities.iter().zip(fills) {
+            for ((ids, faces), fill) in comps.iter().zip(&cavities).zip(fills) {
                 match fill {
                     Ok(fill) => self.apply_fill(faces, fill),
                     Err(e) => {
@@ -89,14 +84,7 @@ impl<'a> Front<'a> {
         let live: Vec<u32> = (0..self.fv.len() as u32)
             .filter(|&f| self.fv[f as usize].alive)
             .collect();
-        let mut by_edge: FxHashMap<(u32, u32), Vec<u32>> = FxHashMap::default();
-        for &f in &live {
-            let v = self.fv[f as usize].v;
-            for k in 0..3 {
-                let (a, b) = (v[k], v[(k + 1) % 3]);
-                by_edge.entry((a.min(b), a.max(b))).or_default().push(f);
-            }
-        }
+        let by_edge = self.faces_by_edge(&live);
         let mut comp: FxHashMap<u32, usize> = FxHashMap::default();
         let mut out: Vec<Vec<u32>> = Vec::new();
         for &s in &live {
@@ -168,16 +156,8 @@ impl<'a> Front<'a> {
         for i in 0..4 {
             let w = TET_FACES[i].map(|k| tv[k]);
             let fr = 4 * t + i as u32;
-            if let Some(g) = self.face_id(w) {
-                let o = self.fv[g as usize].owner;
-                self.neigh[fr as usize] = o;
-                if o != NONE {
-                    self.neigh[o as usize] = fr;
-                }
-                self.remove_face(g);
-            } else {
-                self.add_face(w, fr);
-            }
+            let found = self.face_id(w);
+            self.close_or_open(w, fr, found);
         }
     }
 }

@@ -1466,16 +1466,7 @@ impl<'a> Front<'a> {
                 Some(m) if self.fmap.is_none() => (m[i] != NONE).then_some(m[i]),
                 _ => self.face_id(w),
             };
-            if let Some(g) = found {
-                let o = self.fv[g as usize].owner;
-                self.neigh[fr as usize] = o;
-                if o != NONE {
-                    self.neigh[o as usize] = fr;
-                }
-                self.remove_face(g);
-            } else {
-                self.add_face(w, fr);
-            }
+            self.close_or_open(w, fr, found);
         }
         if self.opts.progress_every > 0 && self.stats.tets % self.opts.progress_every == 0 {
             if let Some(p) = &self.opts.progress {
@@ -1486,6 +1477,35 @@ impl<'a> Front<'a> {
                 );
             }
         }
+    }
+
+    /// AF5 for a new tet's face `w` (`fr` = `4t+f`): a matching front face
+    /// `found` leaves the front, the two tets linked; else `w` joins it.
+    #[inline]
+    fn close_or_open(&mut self, w: [u32; 3], fr: u32, found: Option<u32>) {
+        if let Some(g) = found {
+            let o = self.fv[g as usize].owner;
+            self.neigh[fr as usize] = o;
+            if o != NONE {
+                self.neigh[o as usize] = fr;
+            }
+            self.remove_face(g);
+        } else {
+            self.add_face(w, fr);
+        }
+    }
+
+    /// The faces among `faces` on each edge (sorted corners).
+    fn faces_by_edge(&self, faces: &[u32]) -> FxHashMap<(u32, u32), Vec<u32>> {
+        let mut by_edge: FxHashMap<(u32, u32), Vec<u32>> = FxHashMap::default();
+        for &f in faces {
+            let v = self.fv[f as usize].v;
+            for k in 0..3 {
+                let (a, b) = (v[k], v[(k + 1) % 3]);
+                by_edge.entry((a.min(b), a.max(b))).or_default().push(f);
+            }
+        }
+        by_edge
     }
 
     /// Drop dead tets and unused new points; input points keep their ids.
