@@ -174,6 +174,11 @@ struct MeshArgs {
     /// per 100k tets, 1 serial. The mesh depends on it, not on --threads.
     #[arg(long)]
     optimize_parts: Option<usize>,
+    /// Recovery rounds of a stalled front before the constrained fill
+    /// closes its cavities, and between the fill's tries; 0: only where the
+    /// front would give up.
+    #[arg(long, value_name = "ROUNDS", default_value_t = parafront_front::DEFAULT_FILL_AFTER)]
+    fill_after: u32,
 }
 
 #[derive(Args)]
@@ -326,6 +331,7 @@ fn mesh_options(a: &MeshArgs) -> Result<MeshOptions, Fail> {
     if let Some(n) = a.optimize_parts {
         o.optimize_parts = n;
     }
+    o.fill_after = a.fill_after;
     if a.parts == 0 {
         return Err(Fail(2, "--parts must be at least 1".into()));
     }

@@ -1,5 +1,5 @@
 //! Fill the cavity in an OBJ file (faces pointing into it) and report:
-//! `cargo run --example fill_obj -- CAVITY.obj`.
+//! `cargo run --example fill_obj -- CAVITY.obj [MAX_STEINER MAX_STEINER_FACES MAX_SEARCH_FACES]`.
 use parafront_delaunay::{fill_cavity, FillOptions};
 use std::time::Instant;
 
@@ -42,7 +42,23 @@ fn main() {
     }
     println!("{bad} pairs of faces meet");
     let t0 = Instant::now();
-    match fill_cavity(&pts, &faces, &FillOptions::default()) {
+    // Optional: MAX_STEINER MAX_STEINER_FACES MAX_SEARCH_FACES.
+    let mut opts = FillOptions::default();
+    let arg = |k: usize| {
+        std::env::args()
+            .nth(k)
+            .map(|a| a.parse::<usize>().expect("a count"))
+    };
+    if let Some(n) = arg(2) {
+        opts.max_steiner = n;
+    }
+    if let Some(n) = arg(3) {
+        opts.max_steiner_faces = n;
+    }
+    if let Some(n) = arg(4) {
+        opts.max_search_faces = n;
+    }
+    match fill_cavity(&pts, &faces, &opts) {
         Ok(f) => println!(
             "{path}: {} faces: {} tets, {} Steiner points, {:?}, {} flips, {:.3} s",
             faces.len(),

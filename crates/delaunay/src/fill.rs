@@ -5,6 +5,7 @@
 //! kernel's deepest point instead. Every result is verified exactly.
 use crate::flips::key3;
 use crate::recover::{crossings, recover_all};
+use crate::search::search_fill;
 use crate::tri::{InsertError, Triangulation, NONE, TET_FACES};
 use parafront_geom::{centroid3, kernel::deepest_point, orient3d, tri_normal, P3};
 use rustc_hash::{FxHashMap, FxHashSet};
@@ -21,6 +22,10 @@ pub struct FillOptions {
     /// Cavities with more faces get no Steiner points (their search is
     /// slow, and growing them serves better).
     pub max_steiner_faces: usize,
+    /// Steps the search (the fill's second method) may take per try.
+    pub search_nodes: usize,
+    /// Cavities with more faces are not searched.
+    pub max_search_faces: usize,
 }
 
 impl Default for FillOptions {
@@ -30,6 +35,8 @@ impl Default for FillOptions {
             flips_per_face: 32,
             attempts: 6,
             max_steiner_faces: 200,
+            search_nodes: 4000,
+            max_search_faces: 400,
         }
     }
 }
@@ -42,6 +49,9 @@ pub enum FillMethod {
     Delaunay,
     /// Cones from one interior point that sees every face.
     Cone,
+    /// Tets found by a search over the cavity's points (and Steiner
+    /// points), each verified in the cavity.
+    Search,
 }
 
 /// A cavity's fill.
@@ -92,31 +102,46 @@ pub fn fill_cavity(
     local.sort_unstable();
     local.dedup();
     let mut flips = 0;
-    let mut missing = 0;
+    // The Delaunay triangulation of its points, faces recovered by flips.
+    let mut missing = match delaunay_fill(points, faces, &local, opts, false, &mut flips)? {
+        Ok(f) => return Ok(f),
+        Err(m) => m,
+    };
+    // Flips are stuck: a star-shaped cavity takes the cone.
+    if let Some(f) = cone(points, faces) {
+        return Ok(f);
+    }
+    // Then the search, which tiles what no single point sees.
+    if faces.len() <= opts.max_search_faces {
+        let steiner = opts.max_steiner + faces.len() / 2;
+        if let Some((steiner, tets)) = search_fill(points, faces, opts.search_nodes, steiner) {
+            return Ok(Fill {
+                steiner,
+                tets,
+                method: FillMethod::Search,
+                flips,
+            });
+        }
+    }
+    // Last, Steiner points in the triangulation, under other symbolic
+    // perturbations (on CAD's coplanar and cospherical points they pick
+    // other diagonals).
     let attempts = if faces.len() > opts.max_steiner_faces {
-        1
+        0
     } else {
-        opts.attempts.max(1)
+        opts.attempts
     };
     for attempt in 0..attempts {
         if attempt > 0 {
-            // Another symbolic perturbation: on CAD's coplanar and
-            // cospherical points it picks other diagonals.
             let key = |v: u32| {
                 (v as u64 ^ (attempt as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15))
                     .wrapping_mul(0xff51_afd7_ed55_8ccd)
             };
             local.sort_unstable_by_key(|&v| key(v));
         }
-        match delaunay_fill(points, faces, &local, opts, &mut flips)? {
+        match delaunay_fill(points, faces, &local, opts, true, &mut flips)? {
             Ok(f) => return Ok(f),
             Err(m) => missing = m,
-        }
-        if attempt == 0 {
-            // Flips are stuck: a star-shaped cavity takes the cone.
-            if let Some(f) = cone(points, faces) {
-                return Ok(f);
-            }
         }
     }
     Err(FillError::Unrecovered {
@@ -133,6 +158,7 @@ fn delaunay_fill(
     faces: &[[u32; 3]],
     local: &[u32],
     opts: &FillOptions,
+    with_steiner: bool,
     flips: &mut usize,
 ) -> Result<Result<Fill, usize>, FillError> {
     let lp: Vec<P3> = local.iter().map(|&i| points[i as usize]).collect();
@@ -160,7 +186,7 @@ fn delaunay_fill(
             return Ok(Err(1));
         }
         // Large cavities are grown by the caller rather than searched.
-        if cf.len() > opts.max_steiner_faces {
+        if !with_steiner || cf.len() > opts.max_steiner_faces {
             return Ok(Err(missing.len()));
         }
         // Steiner points near the stuck faces, strictly inside the cavity.
@@ -408,17 +434,25 @@ fn steiner_near(tri: &Triangulation, cf: &[[u32; 3]], m: usize) -> Option<P3> {
     (sees && inside(tri, cf, q)).then_some(q)
 }
 
-/// Whether `q` lies strictly inside the closed surface `cf`: a ray's
-/// crossings, counted with the exact segment-triangle test, along the first
-/// of a few directions that meets no edge or corner.
+/// Whether `q` lies strictly inside the closed surface `cf`.
 fn inside(tri: &Triangulation, cf: &[[u32; 3]], q: P3) -> bool {
+    inside_surface(&tri.pts, cf, q)
+}
+
+/// Whether `q` lies strictly inside the closed surface `faces` of `pts`: a
+/// ray's crossings, counted with the exact segment-triangle test, along the
+/// first of a few directions that meets no edge or corner.
+pub(crate) fn inside_surface(pts: &[P3], faces: &[[u32; 3]], q: P3) -> bool {
     use parafront_geom::intersect::segment_triangle_parity;
-    let far = 1e3
-        * tri.pts[0]
-            .iter()
-            .zip(&q)
-            .map(|(a, b)| (a - b).abs())
-            .fold(1.0, f64::max);
+    let mut far: f64 = 1.0;
+    for f in faces {
+        for &v in f {
+            for k in 0..3 {
+                far = far.max((pts[v as usize][k] - q[k]).abs());
+            }
+        }
+    }
+    let far = 4.0 * far;
     let dirs = [
         [0.577, 0.0321, 0.816],
         [-0.31, 0.77, 0.2],
@@ -428,8 +462,8 @@ fn inside(tri: &Triangulation, cf: &[[u32; 3]], q: P3) -> bool {
     'dir: for d in dirs {
         let e = [q[0] + far * d[0], q[1] + far * d[1], q[2] + far * d[2]];
         let mut odd = false;
-        for f in cf {
-            let p = f.map(|v| tri.pts[v as usize]);
+        for f in faces {
+            let p = f.map(|v| pts[v as usize]);
             match segment_triangle_parity(q, e, p[0], p[1], p[2]) {
                 Some(true) => odd = !odd,
                 Some(false) => {}

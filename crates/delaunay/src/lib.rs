@@ -19,6 +19,7 @@ mod fill;
 mod flips;
 mod predicates;
 mod recover;
+mod search;
 mod tri;
 
 pub use check::CheckError;

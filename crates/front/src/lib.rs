@@ -16,7 +16,7 @@ mod queue;
 
 pub use crate::core::{
     advance, FrontError, FrontInput, FrontOptions, FrontResult, FrontStats, Partial,
-    MAX_GROWTH_PER_TET,
+    DEFAULT_FILL_AFTER, MAX_GROWTH_PER_TET,
 };
 
 use std::sync::atomic::{AtomicU64, Ordering};

@@ -403,6 +403,7 @@ pub(crate) fn build_ddg_at<C: Comm>(
         Sizes::fine(&field),
         &mut next_gid,
         &DDG_SERIAL_ROUNDS,
+        parafront_front::DEFAULT_FILL_AFTER,
     )?;
     if debug {
         eprintln!(

@@ -40,6 +40,9 @@ pub struct ParOptions {
     /// pass on what they leave: [`build_ddg`]); 0 builds it with the
     /// serial front.
     pub ddg_passes: usize,
+    /// Recovery rounds of pass 4's front before the constrained fill takes
+    /// over (`FrontOptions::fill_after`).
+    pub fill_after: u32,
 }
 
 /// Parallel passes of the DDG's build by default.
@@ -53,6 +56,7 @@ impl Default for ParOptions {
             layers: 2,
             partition: ddg::Partition::default(),
             ddg_passes: DEFAULT_DDG_PASSES,
+            fill_after: parafront_front::DEFAULT_FILL_AFTER,
         }
     }
 }
@@ -552,6 +556,7 @@ pub fn mesh_parallel<C: Comm>(
         Sizes::fine(size),
         &mut next_gid,
         &PASS4_ROUNDS,
+        opts.fill_after,
     )?;
     st.pass_tets[3] = made4;
     st.peeled_tets += removed;
@@ -1333,6 +1338,7 @@ fn serial_pass<C: Comm>(
     size: Sizes<'_>,
     next_gid: &mut u32,
     rounds: &[u32],
+    fill_after: u32,
 ) -> Result<(usize, usize), PassError> {
     let last = rounds.len() - 1;
     let out: Vec<Vec<(u32, [Rec; 3])>> = parts
@@ -1384,6 +1390,7 @@ fn serial_pass<C: Comm>(
                 recovery_rounds: rounds[peel],
                 keep_partial: peel < last,
                 max_growth: size.max_growth,
+                fill_after,
                 ..FrontOptions::default()
             },
         );

@@ -74,6 +74,15 @@ pub struct MeshOptions {
     /// 1 serial. See `parafront_improve::ImproveOptions::parts`.
     #[serde(default)]
     pub optimize_parts: usize,
+    /// Recovery rounds of a stalled front before the constrained fill
+    /// closes its cavities, and between the fill's tries (issue 20); 0: only
+    /// where the front would give up.
+    #[serde(default = "default_fill_after")]
+    pub fill_after: u32,
+}
+
+fn default_fill_after() -> u32 {
+    parafront_front::DEFAULT_FILL_AFTER
 }
 
 fn default_optimize() -> u8 {
@@ -96,6 +105,7 @@ impl Default for MeshOptions {
             optimize: default_optimize(),
             optimize_parts: 0,
             regions: false,
+            fill_after: default_fill_after(),
         }
     }
 }
@@ -368,6 +378,7 @@ fn serial_region(
         &FrontOptions {
             progress: opts.progress.clone(),
             keep_partial: opts.debug_partial,
+            fill_after: opts.fill_after,
             ..FrontOptions::default()
         },
     )
@@ -451,6 +462,7 @@ fn mesh_parts(
         ddg_passes: opts
             .ddg_passes
             .unwrap_or(parafront_passes::DEFAULT_DDG_PASSES),
+        fill_after: opts.fill_after,
         ..ParOptions::default()
     };
     let comm = parafront_comm::Threads::new(opts.parts);

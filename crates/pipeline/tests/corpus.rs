@@ -72,6 +72,18 @@ fn tray_cad_needles() {
 #[test]
 fn plate_cad_caps() {
     // Caps (0.024 / 3.2 / 176.7 degrees) and needles 120 long on a plate
-    // 12.7 thick: recovery needs about 110 rounds.
+    // 12.7 thick: the constrained fill closes what recovery leaves.
     mesh_file("plate_holes.STL");
+}
+
+#[test]
+fn round_tube_thin_wall() {
+    // A tube with a wall 0.3 thick and sides 8.7 long: recovery alone never
+    // closed it (issue 20); the fill's search does, with Steiner points.
+    let Some(dir) = corpus() else { return };
+    let s = read_surface(&dir.join("round.stl")).unwrap();
+    let (m, summary) = mesh_surface(&s, &MeshOptions::default()).expect("round.stl meshes");
+    m.check_against_surface(&s.tris).expect("valid");
+    assert!(summary.cavities_filled > 0, "the fill closed it");
+    assert!(summary.fill_tets > 0);
 }

@@ -31,6 +31,7 @@ impl<'a> Front<'a> {
                 .map(|c| c.iter().map(|&f| self.fv[f as usize].v).collect())
                 .collect();
             let pts = &self.pts;
+            let n0 = pts.len() as u32;
             let fills: Vec<_> = cavities
                 .par_iter()
                 .map(|faces| fill_cavity(pts, faces, &fopts))
@@ -38,7 +39,7 @@ impl<'a> Front<'a> {
             let mut failed: Vec<u32> = Vec::new();
             for ((ids, faces), fill) in comps.iter().zip(&cavities).zip(fills) {
                 match fill {
-                    Ok(fill) => self.apply_fill(faces, fill),
+                    Ok(fill) => self.apply_fill(faces, fill, n0),
                     Err(e) => {
                         tracing::debug!(faces = faces.len(), error = %e, "cavity not filled");
                         failed.extend_from_slice(ids);
@@ -116,9 +117,18 @@ impl<'a> Front<'a> {
     }
 
     /// Add a fill's points and tets; each tet's faces close the front faces
-    /// they meet and open the others (AF5 on all four faces).
-    fn apply_fill(&mut self, faces: &[[u32; 3]], fill: parafront_delaunay::Fill) {
+    /// they meet and open the others (AF5 on all four faces). The fill
+    /// numbered its Steiner points from `n0`, the point count when the
+    /// round's fills were computed; earlier fills may have added points since.
+    fn apply_fill(&mut self, faces: &[[u32; 3]], mut fill: parafront_delaunay::Fill, n0: u32) {
         let n = self.pts.len() as u32;
+        for t in &mut fill.tets {
+            for v in t.iter_mut() {
+                if *v >= n0 {
+                    *v = *v - n0 + n;
+                }
+            }
+        }
         let mut h = 0.0;
         let mut k = 0usize;
         for f in faces {
