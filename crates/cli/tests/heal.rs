@@ -287,3 +287,31 @@ fn a_file_without_triangles_says_so() {
     assert_eq!(code, Some(1));
     assert!(out.contains("no triangles"), "{out}");
 }
+
+/// Both dirty CAD exports heal and mesh, and the mesh keeps the healed
+/// surface (angle_block's front needed the constrained fill's search:
+/// issue 20 blocked this before).
+#[test]
+fn the_dirty_corpus_heals_and_meshes() {
+    let Some(dir) = std::env::var_os("PARAFRONT_GEOMETRY") else {
+        println!("PARAFRONT_GEOMETRY unset: skipped");
+        return;
+    };
+    for name in ["angle_block", "idler_riser"] {
+        let src = Path::new(&dir).join(format!("dirty/{name}.STL"));
+        let vol = tmp(&format!("{name}.vtu"));
+        let hs = tmp(&format!("{name}_healed.stl"));
+        let (code, out, err) = run(&[
+            &"mesh",
+            &src,
+            &"-o",
+            &vol,
+            &"--heal",
+            &"--healed-surface",
+            &hs,
+        ]);
+        assert_eq!(code, Some(0), "{name}: {out}{err}");
+        assert!(out.contains("merged") && out.contains("tets"), "{out}");
+        meshcheck(&vol, &hs);
+    }
+}

@@ -4,6 +4,11 @@ use parafront_delaunay::{fill_cavity, FillOptions};
 use std::time::Instant;
 
 fn main() {
+    // RUST_LOG=parafront_delaunay=trace shows the search's steps.
+    tracing_subscriber::fmt()
+        .with_env_filter(tracing_subscriber::EnvFilter::from_default_env())
+        .with_writer(std::io::stderr)
+        .init();
     let path = std::env::args().nth(1).expect("usage: fill_obj CAVITY.obj");
     let text = std::fs::read_to_string(&path).expect("read");
     let (mut pts, mut faces) = (Vec::new(), Vec::new());

@@ -1,8 +1,9 @@
-//! The constrained fill of a closed cavity (issue 20): the Delaunay
-//! tetrahedralization of its points, its faces recovered by flips, Steiner
-//! points strictly inside it where flips cannot, the tets outside removed.
-//! A star-shaped cavity the recovery cannot close takes the cone from its
-//! kernel's deepest point instead. Every result is verified exactly.
+//! The constrained fill of a closed cavity (issue 20), in order: the
+//! Delaunay tetrahedralization of its points with its faces recovered by
+//! flips and the tets outside removed; the cone from its kernel's deepest
+//! point (a star-shaped cavity); the search (`search.rs`); Steiner points
+//! strictly inside it in the triangulation, under other perturbations.
+//! Every result is verified exactly.
 use crate::flips::key3;
 use crate::recover::{crossings, recover_all};
 use crate::search::search_fill;
@@ -33,7 +34,7 @@ impl Default for FillOptions {
         FillOptions {
             max_steiner: 16,
             flips_per_face: 32,
-            attempts: 6,
+            attempts: 1,
             max_steiner_faces: 200,
             search_nodes: 4000,
             max_search_faces: 400,

@@ -12,8 +12,11 @@
 //! [`fill_cavity`] builds on it: given a closed triangulated surface (a
 //! stalled front's cavity), it returns tets that fill it exactly and keep
 //! every surface triangle. It triangulates the cavity's points, recovers the
-//! missing faces by flips, adds Steiner points strictly inside the cavity
-//! where flips cannot, and keeps the tets inside.
+//! missing faces by flips, and keeps the tets inside. Where flips stall it
+//! tries the cone from the kernel's deepest point, then a search (a front
+//! with exact validity and no quality rules that can step back, adding
+//! Steiner points strictly inside the cavity at its dead ends), then Steiner
+//! points in the triangulation.
 mod check;
 mod fill;
 mod flips;

@@ -82,11 +82,20 @@ pub(crate) fn search_fill(
             );
             return None;
         }
+        let mut steps = Vec::new();
         for &t in deepest.get(done..).unwrap_or(&[]) {
             let f = [t[0], t[1], t[2]];
-            s.apply(f, t[3]);
+            steps.push(s.apply(f, t[3]));
         }
-        let Some(q) = s.steiner() else {
+        // Where the dead end has no point to offer, where this try began.
+        let mut q = s.steiner();
+        if q.is_none() && !steps.is_empty() {
+            while let Some(step) = steps.pop() {
+                s.undo(step);
+            }
+            q = s.steiner();
+        }
+        let Some(q) = q else {
             tracing::debug!(
                 steiner = added,
                 tets = s.tets.len(),
@@ -470,7 +479,7 @@ impl Search {
         };
         with.pts.push([0.0; 3]);
         let v = (with.pts.len() - 1) as u32;
-        let mut best: Option<((usize, usize), P3)> = None;
+        let mut best: Option<((usize, usize, usize), P3)> = None;
         for &f in &hard {
             // Scored on the hard faces, then on the faces about this one.
             let around: Vec<[u32; 3]> = faces
@@ -478,20 +487,39 @@ impl Search {
                 .copied()
                 .filter(|g| g.iter().any(|v| f.contains(v)))
                 .collect();
-            for q in self.points_near(f) {
+            let (mut n_in, mut n_ok) = (0, 0);
+            let near = self.points_near(f);
+            for &q in &near {
                 if !self.inside(&faces, q) {
                     continue;
                 }
+                n_in += 1;
                 with.pts[v as usize] = q;
                 if !with.valid(f, v) {
                     continue;
                 }
+                n_ok += 1;
                 let helps = hard.iter().filter(|&&g| with.valid(g, v)).count();
                 let sees = around.iter().filter(|&&g| with.valid(g, v)).count();
-                if best.map_or(true, |(b, _)| (helps, sees) > b) {
-                    best = Some(((helps, sees), q));
+                // Faces the point would leave with no apex: each tet they
+                // had holds it, and it is not one of theirs.
+                let kills = self
+                    .front
+                    .values()
+                    .filter(|e| {
+                        !e.cands.is_empty()
+                            && e.cands
+                                .iter()
+                                .all(|&a| self.holds([e.face[0], e.face[1], e.face[2], a], q))
+                            && !with.valid(e.face, v)
+                    })
+                    .count();
+                let score = (helps, usize::MAX - kills, sees);
+                if best.map_or(true, |(b, _)| score > b) {
+                    best = Some((score, q));
                 }
             }
+            tracing::trace!(?f, near = near.len(), n_in, n_ok, "steiner candidates");
         }
         best.map(|(_, q)| q)
     }

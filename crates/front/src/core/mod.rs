@@ -54,6 +54,10 @@ pub const MAX_GROWTH_PER_TET: f64 = 2.0;
 /// closes round.stl in 6 s where 10 took 6 s and 200 failed; 1 and 2 fill
 /// larger, harder cavities (the tray takes 40-70 s).
 pub const DEFAULT_FILL_AFTER: u32 = 4;
+/// Fills that leave a cavity open before the front gives up: each costs
+/// seconds on a front that has them (a slot under 10 times its width took
+/// minutes of recovery and fill rounds before this bound).
+const FILL_TRIES: u32 = 4;
 
 const NONE: u32 = u32::MAX;
 /// How far a new point keeps from front faces, in sizes, by round.
@@ -797,6 +801,7 @@ impl<'a> Front<'a> {
     fn run(&mut self) -> Result<(), FrontError> {
         let mut fewest_stuck = usize::MAX;
         let mut last_gain = 0;
+        let mut failed_fills = 0;
         loop {
             while let Some(e) = self.heap.pop() {
                 let (key, fid) = (f32::from_bits((e >> 32) as u32) as f64, e as u32);
@@ -840,16 +845,19 @@ impl<'a> Front<'a> {
                 fewest_stuck = self.stuck.len();
                 last_gain = self.relax;
             }
-            let give_up =
-                self.relax >= self.opts.recovery_rounds || self.relax >= last_gain + STALL_ROUNDS;
-            // The fill is the last resort, where the front would give up:
-            // fronts that recovery closes keep their meshes.
-            // Every `fill_after` rounds, and where the front would give up.
+            let give_up = self.relax >= self.opts.recovery_rounds
+                || self.relax >= last_gain + STALL_ROUNDS
+                || failed_fills >= FILL_TRIES;
+            // The fill every `fill_after` rounds, and where the front would
+            // give up.
             let due = self.opts.fill_after > 0
                 && self.relax >= self.opts.fill_after
                 && self.relax % self.opts.fill_after == 0;
-            if self.opts.fill && (give_up || due) && self.fill_stalled(self.opts.fill_growth) {
-                continue;
+            if self.opts.fill && (give_up || due) {
+                if self.fill_stalled(self.opts.fill_growth) {
+                    continue;
+                }
+                failed_fills += 1;
             }
             if give_up {
                 return Err(self.stuck_error());
