@@ -179,6 +179,19 @@ struct MeshArgs {
     /// front would give up.
     #[arg(long, value_name = "ROUNDS", default_value_t = parafront_front::DEFAULT_FILL_AFTER)]
     fill_after: u32,
+    /// With --parts > 1: a region less deep than this many mean surface
+    /// edges (volume over area) is meshed by the serial front instead (0:
+    /// never).
+    #[arg(long, value_name = "EDGES", default_value_t = parafront_pipeline::THIN_DEPTH)]
+    thin_depth: f64,
+    /// With --parts > 1: a region whose passes 1 to 3 leave more than this
+    /// share of its volume is meshed by the serial front instead (2: never).
+    #[arg(long, value_name = "SHARE", default_value_t = parafront_pipeline::SERIAL_FROM)]
+    serial_from: f64,
+    /// With --parts > 1: the domain-defining grid's largest size on deep
+    /// fronts, as a share of a part's width.
+    #[arg(long, value_name = "SHARE", default_value_t = parafront_pipeline::DDG_CAP)]
+    ddg_cap: f64,
 }
 
 #[derive(Args)]
@@ -332,6 +345,9 @@ fn mesh_options(a: &MeshArgs) -> Result<MeshOptions, Fail> {
         o.optimize_parts = n;
     }
     o.fill_after = a.fill_after;
+    o.thin_depth = a.thin_depth;
+    o.serial_from = a.serial_from;
+    o.ddg_cap = a.ddg_cap;
     if a.parts == 0 {
         return Err(Fail(2, "--parts must be at least 1".into()));
     }

@@ -258,20 +258,15 @@ pub(crate) fn depth(points: &[P3], faces: &[[u32; 3]]) -> f64 {
 /// move each wall by two layers of DDG tets; where a DDG tet is as wide
 /// as a part, two layers reach every part, and the front that pass 1
 /// leaves there all goes to one part in pass 2 (sphere_5e6 on 16 parts:
-/// 30 % of pass 2 on one).
-fn cap_share() -> f64 {
-    std::env::var("PARAFRONT_DDG_CAP")
-        .ok()
-        .and_then(|s| s.parse().ok())
-        .unwrap_or(0.2)
-}
+/// 30 % of pass 2 on one). `ParOptions::ddg_cap`.
+pub const DDG_CAP: f64 = 0.2;
 
-/// [`cap_share`] times a part's width: no cap on one part.
-fn size_cap(points: &[P3], faces: &[[u32; 3]], parts: usize) -> f64 {
+/// `cap` times a part's width: no cap on one part.
+fn size_cap(points: &[P3], faces: &[[u32; 3]], parts: usize, cap: f64) -> f64 {
     if parts <= 1 {
         return f64::INFINITY;
     }
-    cap_share() * (enclosed_volume(points, faces) / parts as f64).cbrt()
+    cap * (enclosed_volume(points, faces) / parts as f64).cbrt()
 }
 
 /// The volume the closed front `faces` encloses.
@@ -304,7 +299,15 @@ pub fn build_ddg<C: Comm>(
     passes: usize,
     comm: &C,
 ) -> Result<(Ddg, DdgBuildStats), PassError> {
-    build_ddg_at(points, faces, depth(points, faces), c, passes, comm)
+    build_ddg_at(
+        points,
+        faces,
+        depth(points, faces),
+        c,
+        passes,
+        DDG_CAP,
+        comm,
+    )
 }
 
 /// [`build_ddg`] for a front `depth` mean edges deep ([`depth`]): the
@@ -315,6 +318,7 @@ pub(crate) fn build_ddg_at<C: Comm>(
     depth: f64,
     c: f64,
     passes: usize,
+    cap: f64,
     comm: &C,
 ) -> Result<(Ddg, DdgBuildStats), PassError> {
     let t_all = Instant::now();
@@ -339,7 +343,7 @@ pub(crate) fn build_ddg_at<C: Comm>(
     // cap at the first layer's size costs tets (spot on 32 parts: +4.2 %
     // against P = 1 instead of +2.9 %).
     let cap = if depth >= DEEP {
-        size_cap(points, faces, np).max(point_size.iter().cloned().fold(0.0, f64::max))
+        size_cap(points, faces, np, cap).max(point_size.iter().cloned().fold(0.0, f64::max))
     } else {
         f64::INFINITY
     };
@@ -354,7 +358,7 @@ pub(crate) fn build_ddg_at<C: Comm>(
 
     let mut parts = seed_parts(np, points, &point_size, faces);
     let mut next_gid = points.len() as u32;
-    let debug = std::env::var_os("PARAFRONT_DEBUG_PASSES").is_some();
+    let debug = tracing::enabled!(tracing::Level::DEBUG);
     for j in 0..passes {
         let t0 = Instant::now();
         // The cells split the faces still to advance (an all-gather of
@@ -383,7 +387,7 @@ pub(crate) fn build_ddg_at<C: Comm>(
         let peeled = peel_stuck(&mut parts, comm);
         if debug {
             let fr: usize = parts.iter().map(|p| p.front.len()).sum();
-            eprintln!(
+            tracing::debug!(
                 "ddg pass {}: tets {:?}, front left {fr}, {peeled} peeled, {:.3} s",
                 j + 1,
                 tets,
@@ -406,7 +410,7 @@ pub(crate) fn build_ddg_at<C: Comm>(
         parafront_front::DEFAULT_FILL_AFTER,
     )?;
     if debug {
-        eprintln!(
+        tracing::debug!(
             "ddg serial pass: {made} tets, {:.3} s",
             t0.elapsed().as_secs_f64()
         );

@@ -43,7 +43,18 @@ pub struct ParOptions {
     /// Recovery rounds of pass 4's front before the constrained fill takes
     /// over (`FrontOptions::fill_after`).
     pub fill_after: u32,
+    /// Depth in mean surface edges (volume over area) under which a region
+    /// skips the passes ([`PassError::Thin`]; 0: never).
+    pub thin_depth: f64,
+    /// Share of the volume left after pass 3 above which the region is
+    /// meshed serially ([`PassError::Unsuited`]; 2: never).
+    pub serial_from: f64,
+    /// On deep fronts, the DDG's largest size as a share of a part's width
+    /// (the cube root of its volume).
+    pub ddg_cap: f64,
 }
+
+pub use ddg_build::DDG_CAP;
 
 /// Parallel passes of the DDG's build by default.
 pub const DEFAULT_DDG_PASSES: usize = 2;
@@ -57,6 +68,9 @@ impl Default for ParOptions {
             partition: ddg::Partition::default(),
             ddg_passes: DEFAULT_DDG_PASSES,
             fill_after: parafront_front::DEFAULT_FILL_AFTER,
+            thin_depth: THIN_DEPTH,
+            serial_from: SERIAL_FROM,
+            ddg_cap: ddg_build::DDG_CAP,
         }
     }
 }
@@ -333,14 +347,15 @@ pub fn mesh_parallel<C: Comm>(
         ..Default::default()
     };
     let depth = ddg_build::depth(points, faces);
-    if depth < thin_depth() {
+    if depth < opts.thin_depth {
         return Err(PassError::Thin { depth });
     }
     // §5 step 1: the DDG (replicated: it is small).
     let cpu0 = process_cpu_seconds();
     let t_ddg = Instant::now();
     let built = if opts.ddg_passes > 0 {
-        match ddg_build::build_ddg_at(points, faces, depth, opts.growth, opts.ddg_passes, comm) {
+        let (c, passes, cap) = (opts.growth, opts.ddg_passes, opts.ddg_cap);
+        match ddg_build::build_ddg_at(points, faces, depth, c, passes, cap, comm) {
             Ok((d, bs)) => {
                 st.ddg_build = Some(bs);
                 Some(d)
@@ -348,8 +363,8 @@ pub fn mesh_parallel<C: Comm>(
             // The serial front gets another go (deterministic: the same
             // failure on any thread count); `ddg_build` stays `None`.
             Err(e) => {
-                if std::env::var_os("PARAFRONT_DEBUG_PASSES").is_some() {
-                    eprintln!("the DDG's passes failed ({e}); the serial front builds it");
+                if tracing::enabled!(tracing::Level::DEBUG) {
+                    tracing::debug!("the DDG's passes failed ({e}); the serial front builds it");
                 }
                 None
             }
@@ -411,8 +426,8 @@ pub fn mesh_parallel<C: Comm>(
         st.ddg_cpu_seconds = b - a;
         st.partition_cpu_seconds = c - b;
     }
-    if std::env::var_os("PARAFRONT_DEBUG_PASSES").is_some() {
-        eprintln!(
+    if tracing::enabled!(tracing::Level::DEBUG) {
+        tracing::debug!(
             "partition: weights {t_w:.3} s, split {t_split:.3} s (with the locator {t_rcb:.3} s)"
         );
     }
@@ -457,9 +472,9 @@ pub fn mesh_parallel<C: Comm>(
             }
             let up = ddg::shifted(&d, base, Shift::FromHigher, opts.layers);
             let down = ddg::shifted(&d, base, Shift::FromLower, opts.layers);
-            if std::env::var_os("PARAFRONT_DEBUG_PASSES").is_some() {
+            if tracing::enabled!(tracing::Level::DEBUG) {
                 let loads = ddg::shift_loads(&d, base, &left, opts.layers, np);
-                eprintln!(
+                tracing::debug!(
                     "relabelled for pass {}: {:.3} s, front left per part {loads:?}",
                     j + 1,
                     t.elapsed().as_secs_f64()
@@ -507,10 +522,10 @@ pub fn mesh_parallel<C: Comm>(
         st.pass_tets[label] += tets.iter().sum::<usize>();
         st.part_seconds.push(secs);
         st.crossing_passes = j.saturating_sub(2);
-        if std::env::var_os("PARAFRONT_DEBUG_PASSES").is_some() {
+        if tracing::enabled!(tracing::Level::DEBUG) {
             let fr: usize = parts.iter().map(|p| p.front.len()).sum();
             let stuck: usize = parts.iter().map(|p| p.stuck.len() / 3).sum();
-            eprintln!(
+            tracing::debug!(
                 "pass {} tets {:?} front left {fr}, {stuck} stuck",
                 if j < 3 {
                     format!("{}", j + 1)
@@ -522,8 +537,8 @@ pub fn mesh_parallel<C: Comm>(
         }
         // Room for the next pass around what this one left stuck.
         let peeled = peel_stuck(&mut parts, comm);
-        if std::env::var_os("PARAFRONT_DEBUG_PASSES").is_some() {
-            eprintln!(
+        if tracing::enabled!(tracing::Level::DEBUG) {
+            tracing::debug!(
                 "after pass {}: {peeled} tets peeled around stuck faces",
                 j + 1
             );
@@ -541,10 +556,10 @@ pub fn mesh_parallel<C: Comm>(
     // A thin part leaves most of its volume to pass 4: then the serial
     // front on the whole region is both faster and the serial mesh.
     let left = left_fraction(&parts, comm, points, faces);
-    if std::env::var_os("PARAFRONT_DEBUG_PASSES").is_some() {
-        eprintln!("before pass 4: {:.2} % of the volume left", 100.0 * left);
+    if tracing::enabled!(tracing::Level::DEBUG) {
+        tracing::debug!("before pass 4: {:.2} % of the volume left", 100.0 * left);
     }
-    if left > serial_from() {
+    if left > opts.serial_from {
         return Err(PassError::Unsuited { left });
     }
 
@@ -751,8 +766,8 @@ fn front_call(
         .iter()
         .map(|f| is_stuck(&res, *f, &*filter))
         .collect();
-    if std::env::var_os("PARAFRONT_DEBUG_PASSES").is_some() {
-        eprintln!(
+    if tracing::enabled!(tracing::Level::DEBUG) {
+        tracing::debug!(
             "part {k}: {} points in, {} owned faces, {} tets, front {t_front:.3} s, pockets {t_pockets:.3} s ({pocket_tets} tets), stuck check {:.3} s",
             gids.len(),
             n_owned,
@@ -900,9 +915,9 @@ const MAX_CROSSING: usize = 3;
 const CROSSING_FROM: f64 = 0.0025;
 
 /// Share of the region's volume left after pass 3 above which the region
-/// is meshed serially instead ([`PassError::Unsuited`]); the environment
-/// variable `PARAFRONT_SERIAL_FROM` overrides it (2: never).
-const SERIAL_FROM: f64 = 0.25;
+/// is meshed serially instead ([`PassError::Unsuited`];
+/// `ParOptions::serial_from`).
+pub const SERIAL_FROM: f64 = 0.25;
 
 /// The share of the volume inside `faces` (the input front) that the
 /// parts' fronts still enclose.
@@ -929,21 +944,6 @@ fn left_fraction<C: Comm>(parts: &[Part], comm: &C, points: &[P3], faces: &[[u32
     } else {
         0.0
     }
-}
-
-/// [`THIN_DEPTH`], or `PARAFRONT_THIN_DEPTH` (0: never).
-fn thin_depth() -> f64 {
-    std::env::var("PARAFRONT_THIN_DEPTH")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(THIN_DEPTH)
-}
-
-fn serial_from() -> f64 {
-    std::env::var("PARAFRONT_SERIAL_FROM")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(SERIAL_FROM)
 }
 
 /// Largest pocket (faces) a pass closes itself.
@@ -1039,8 +1039,8 @@ fn close_pockets(
         }
         let hm = hsum / faces.len() as f64;
         let pocket = vol < 0.0 && -vol <= faces.len() as f64 * hm * hm * hm;
-        if std::env::var_os("PARAFRONT_DEBUG_PASSES").is_some() && closed {
-            eprintln!(
+        if tracing::enabled!(tracing::Level::DEBUG) && closed {
+            tracing::debug!(
                 "pocket: {} faces, vol {vol:.3e}, h {hm:.3e}, taken {}",
                 faces.len(),
                 pocket && faces.len() <= MAX_POCKET
@@ -1394,8 +1394,8 @@ fn serial_pass<C: Comm>(
                 ..FrontOptions::default()
             },
         );
-        if std::env::var_os("PARAFRONT_DEBUG_PASSES").is_some() {
-            eprintln!(
+        if tracing::enabled!(tracing::Level::DEBUG) {
+            tracing::debug!(
                 "pass 4: try {peel} on {} faces, {removed} tets peeled so far: {}",
                 hole.len(),
                 if res.is_ok() { "closed" } else { "stuck" }
@@ -1414,8 +1414,8 @@ fn serial_pass<C: Comm>(
                     .collect();
                 g.sort_unstable();
                 g.dedup();
-                if std::env::var_os("PARAFRONT_DEBUG_PASSES").is_some() {
-                    eprintln!(
+                if tracing::enabled!(tracing::Level::DEBUG) {
+                    tracing::debug!(
                         "pass 4: {} faces left, {} older points",
                         partial.as_ref().map_or(0, |p| p.front.len()),
                         g.len()

@@ -11,8 +11,8 @@ pub use regions::{material_regions, RegionFront};
 use parafront_ddg::DdgError;
 use parafront_front::{advance, FrontError, FrontInput, FrontOptions, SizeMode};
 use parafront_mesh::{CheckError, PointId, QualityReport, TetMesh};
-pub use parafront_passes::process_cpu_seconds;
 use parafront_passes::{mesh_parallel, ParOptions, ParOutput, ParStats, PassError, Piece};
+pub use parafront_passes::{process_cpu_seconds, DDG_CAP, SERIAL_FROM, THIN_DEPTH};
 use parafront_size::{SizeError, SizeField, SizeOptions, Sizing};
 use parafront_surface::validate::{shells, validate, Report, Shell, ShellKind};
 use parafront_surface::Surface;
@@ -79,6 +79,31 @@ pub struct MeshOptions {
     /// where the front would give up.
     #[serde(default = "default_fill_after")]
     pub fill_after: u32,
+    /// Parallel mesher: depth in mean surface edges (volume over area)
+    /// under which a region is meshed by the serial front instead (0:
+    /// never). See `parafront_passes::ParOptions::thin_depth`.
+    #[serde(default = "default_thin_depth")]
+    pub thin_depth: f64,
+    /// Parallel mesher: share of the volume left after pass 3 above which
+    /// the region is meshed serially instead (2: never).
+    #[serde(default = "default_serial_from")]
+    pub serial_from: f64,
+    /// Parallel mesher: the DDG's largest size on deep fronts, as a share
+    /// of a part's width.
+    #[serde(default = "default_ddg_cap")]
+    pub ddg_cap: f64,
+}
+
+fn default_thin_depth() -> f64 {
+    ParOptions::default().thin_depth
+}
+
+fn default_serial_from() -> f64 {
+    ParOptions::default().serial_from
+}
+
+fn default_ddg_cap() -> f64 {
+    ParOptions::default().ddg_cap
 }
 
 fn default_fill_after() -> u32 {
@@ -106,6 +131,9 @@ impl Default for MeshOptions {
             optimize_parts: 0,
             regions: false,
             fill_after: default_fill_after(),
+            thin_depth: default_thin_depth(),
+            serial_from: default_serial_from(),
+            ddg_cap: default_ddg_cap(),
         }
     }
 }
@@ -463,6 +491,9 @@ fn mesh_parts(
             .ddg_passes
             .unwrap_or(parafront_passes::DEFAULT_DDG_PASSES),
         fill_after: opts.fill_after,
+        thin_depth: opts.thin_depth,
+        serial_from: opts.serial_from,
+        ddg_cap: opts.ddg_cap,
         ..ParOptions::default()
     };
     let comm = parafront_comm::Threads::new(opts.parts);

@@ -138,7 +138,7 @@ fn needle_plates_mesh() {
 /// between parts crosses it): it is meshed by the serial front, so the mesh
 /// is the serial one, and the summary says why. Its depth (volume over
 /// area, 0.05 edges) says so before the DDG; with that test off
-/// (`PARAFRONT_THIN_DEPTH=0`), the share its passes leave says so after
+/// (`thin_depth: 0`), the share its passes leave says so after
 /// them. A thick body keeps its passes.
 #[test]
 fn thin_plates_skip_the_passes() {
@@ -148,15 +148,12 @@ fn thin_plates_skip_the_passes() {
         ..MeshOptions::default()
     };
     let (serial, _) = mesh_surface(&s, &MeshOptions::default()).unwrap();
-    for (depth_test, why) in [(true, "surface edges deep"), (false, "of the volume")] {
-        if !depth_test {
-            // Only this test meshes a plate this thin: the others do not
-            // see the variable.
-            std::env::set_var("PARAFRONT_THIN_DEPTH", "0");
-        }
-        let run = mesh_surface(&s, &par);
-        std::env::remove_var("PARAFRONT_THIN_DEPTH");
-        let (m, summary) = run.unwrap();
+    for (thin_depth, why) in [(None, "surface edges deep"), (Some(0.0), "of the volume")] {
+        let o = MeshOptions {
+            thin_depth: thin_depth.unwrap_or(par.thin_depth),
+            ..par.clone()
+        };
+        let (m, summary) = mesh_surface(&s, &o).unwrap();
         m.check_against_surface(&s.tris).unwrap();
         assert_eq!(summary.serial_fallback.len(), 1, "{summary:?}");
         let msg = &summary.serial_fallback[0].1;
