@@ -1,0 +1,216 @@
+//! §7: the pockets a pass leaves inside its own part, closed by the front
+//! with recovery on, and the tets they make taken into the part.
+use super::*;
+
+/// Largest pocket (faces) a pass closes itself.
+pub(super) const MAX_POCKET: usize = 4000;
+/// Recovery rounds a pocket gets (the serial front's default is 60): the
+/// removal round and one of kernel cones. Most pockets that close at all
+/// close there; the late rounds' patch cones cost 30 ms or more per pocket
+/// that stays stuck, and with 8 rounds they took 70 % of pass 2's time
+/// (sphere_1e6 at 0.036, P = 8: pockets 6.8 s, 0.16 s with 2 rounds). What
+/// stays open goes to the next pass.
+pub(super) const POCKET_ROUNDS: u32 = 2;
+
+/// Recovery inside a pass (§7 needs it as much as the serial front does):
+/// the faces a pass could not advance without relaxing its acceptance are
+/// left behind, and many form small closed pockets inside the part's own
+/// region. Each such pocket (an edge-connected set of faces the part owns,
+/// closed on its own, facing in, small) is closed here by the front with
+/// recovery on: a closed front bounds what it fills, so no filter is
+/// needed. A pocket that stays stuck is left as it was for the next pass.
+/// Returns the tets made.
+pub(super) fn close_pockets(
+    res: &mut parafront_front::FrontResult,
+    ok: impl Fn(u32) -> bool,
+    size: &(dyn Fn(P3) -> f64 + Sync),
+) -> usize {
+    let own: Vec<usize> = (0..res.front.len())
+        .filter(|&f| res.front[f].iter().all(|&i| ok(i)))
+        .collect();
+    if own.is_empty() {
+        return 0;
+    }
+    // Components through shared edges (union-find over faces).
+    let mut up: Vec<usize> = (0..own.len()).collect();
+    fn root(up: &mut [usize], mut x: usize) -> usize {
+        while up[x] != x {
+            up[x] = up[up[x]];
+            x = up[x];
+        }
+        x
+    }
+    let mut edges: Vec<(u32, u32, usize)> = Vec::with_capacity(own.len() * 3);
+    for (j, &f) in own.iter().enumerate() {
+        let v = res.front[f];
+        for c in 0..3 {
+            let (a, b) = (v[c], v[(c + 1) % 3]);
+            edges.push((a.min(b), a.max(b), j));
+        }
+    }
+    edges.sort_unstable();
+    for w in edges.windows(2) {
+        if (w[0].0, w[0].1) == (w[1].0, w[1].1) {
+            let (a, b) = (root(&mut up, w[0].2), root(&mut up, w[1].2));
+            if a != b {
+                up[a.max(b)] = a.min(b);
+            }
+        }
+    }
+    let mut comp: Vec<(usize, usize)> =
+        (0..own.len()).map(|j| (root(&mut up, j), own[j])).collect();
+    comp.sort_unstable();
+    let mut done = vec![false; res.front.len()];
+    let mut made = 0;
+    let mut i = 0;
+    while i < comp.len() {
+        let mut j = i;
+        while j < comp.len() && comp[j].0 == comp[i].0 {
+            j += 1;
+        }
+        let faces: Vec<[u32; 3]> = comp[i..j].iter().map(|c| res.front[c.1]).collect();
+        // Closed on its own: every directed edge as often as its reverse.
+        let mut e: Vec<(u32, u32)> = Vec::with_capacity(faces.len() * 3);
+        for v in &faces {
+            for c in 0..3 {
+                e.push((v[c], v[(c + 1) % 3]));
+            }
+        }
+        e.sort_unstable();
+        let closed = e.iter().all(|&(a, b)| {
+            let n = |x: (u32, u32)| e.partition_point(|y| *y <= x) - e.partition_point(|y| *y < x);
+            n((a, b)) == n((b, a))
+        });
+        // A large closed set is not a pocket (it may wrap another part's
+        // region); it waits for the next pass.
+        // A pocket is a small cavity: the faces point into it (negative
+        // signed volume), and it holds about a tet per face. A closed set
+        // facing out bounds the rest of the region, not a pocket.
+        let mut vol = 0.0;
+        let mut hsum = 0.0;
+        for f in &faces {
+            let [a, b, c] = f.map(|i| res.points[i as usize]);
+            vol += parafront_geom::dot(a, parafront_geom::cross(b, c)) / 6.0;
+            hsum += f.iter().map(|&i| res.point_size[i as usize]).sum::<f64>() / 3.0;
+        }
+        let hm = hsum / faces.len() as f64;
+        let pocket = vol < 0.0 && -vol <= faces.len() as f64 * hm * hm * hm;
+        if tracing::enabled!(tracing::Level::DEBUG) && closed {
+            tracing::debug!(
+                "pocket: {} faces, vol {vol:.3e}, h {hm:.3e}, taken {}",
+                faces.len(),
+                pocket && faces.len() <= MAX_POCKET
+            );
+        }
+        if closed && pocket && faces.len() <= MAX_POCKET {
+            let mut pts: Vec<u32> = faces.iter().flatten().copied().collect();
+            pts.sort_unstable();
+            pts.dedup();
+            let local = |p: u32| pts.binary_search(&p).unwrap() as u32;
+            let r = advance(
+                FrontInput {
+                    points: pts.iter().map(|&p| res.points[p as usize]).collect(),
+                    point_size: pts.iter().map(|&p| res.point_size[p as usize]).collect(),
+                    faces: faces.iter().map(|f| f.map(local)).collect(),
+                },
+                SizeMode::Field(size),
+                &Everywhere,
+                &FrontOptions {
+                    recovery_rounds: POCKET_ROUNDS,
+                    max_points: 50 * faces.len() + pts.len(),
+                    ..FrontOptions::default()
+                },
+            );
+            if let Ok(r) = r {
+                if r.front.is_empty() {
+                    let base = res.points.len() as u32;
+                    let n = pts.len();
+                    res.points.extend_from_slice(&r.points[n..]);
+                    res.point_size.extend_from_slice(&r.point_size[n..]);
+                    let map = |q: u32| {
+                        if (q as usize) < n {
+                            pts[q as usize]
+                        } else {
+                            base + q - n as u32
+                        }
+                    };
+                    res.tets.extend(r.tets.iter().map(|t| t.map(map)));
+                    made += r.tets.len();
+                    for c in &comp[i..j] {
+                        done[c.1] = true;
+                    }
+                }
+            }
+        }
+        i = j;
+    }
+    let mut k = 0;
+    res.front.retain(|_| {
+        k += 1;
+        !done[k - 1]
+    });
+    made
+}
+
+/// Takes a front call's tets, new points (global ids from `base`) and the
+/// remaining faces it owns into the part's store. Context faces come back
+/// untouched and are dropped: their holder still has them.
+pub(super) fn absorb(part: &mut Part, m: Made, base: u32, pass: u8) -> usize {
+    let Some(r) = m.res else { return 0 };
+    let n_in = m.input_gid.len();
+    let map: Vec<u32> = (0..r.points.len())
+        .map(|i| {
+            let gid = if i < n_in {
+                m.input_gid[i]
+            } else {
+                base + (i - n_in) as u32
+            };
+            part.local(Rec {
+                gid,
+                p: r.points[i],
+                h: r.point_size[i],
+            })
+        })
+        .collect();
+    let ok = |i: u32| (i as usize) >= n_in || m.input_ok[i as usize];
+    for (j, f) in r.front.iter().enumerate() {
+        if f.iter().all(|&i| ok(i)) {
+            part.front.push(f.map(|i| map[i as usize]));
+            if m.stuck.get(j) == Some(&true) {
+                part.stuck
+                    .extend(f.map(|i| part.gid[map[i as usize] as usize]));
+            }
+        }
+    }
+    for t in &r.tets {
+        part.tets.push(t.map(|i| map[i as usize]));
+        part.tet_pass.push(pass);
+    }
+    r.tets.len()
+}
+
+/// Whether face `f` of a pass's result got stuck: the region rules of §7
+/// let the front try it (points and edges inside, the ideal point inside,
+/// computed as the front does), but no tet was accepted.
+pub(super) fn is_stuck(
+    res: &parafront_front::FrontResult,
+    f: [u32; 3],
+    filter: &dyn RegionFilter,
+) -> bool {
+    use parafront_geom::{add, cross, dist, normalize, scale, sub};
+    let p = f.map(|i| res.points[i as usize]);
+    let inside = p.iter().all(|&q| filter.point_ok(q))
+        && filter.edge_ok(p[0], p[1])
+        && filter.edge_ok(p[1], p[2])
+        && filter.edge_ok(p[2], p[0]);
+    if !inside {
+        return false;
+    }
+    let nrm = normalize(cross(sub(p[1], p[0]), sub(p[2], p[0])));
+    let m = [0, 1, 2].map(|k| (p[0][k] + p[1][k] + p[2][k]) / 3.0);
+    let emax = dist(p[0], p[1]).max(dist(p[1], p[2])).max(dist(p[2], p[0]));
+    let h = (f.iter().map(|&i| res.point_size[i as usize]).sum::<f64>() / 3.0).min(2.0 * emax);
+    let dm = (dist(m, p[0]) + dist(m, p[1]) + dist(m, p[2])) / 3.0;
+    let alpha = (h * h - dm * dm).max(0.25 * dm * dm).sqrt();
+    filter.point_ok(add(m, scale(nrm, alpha)))
+}
