@@ -134,6 +134,7 @@ fn shares(h: &Histogram) -> Vec<f64> {
     h.counts.iter().map(|&c| 100.0 * c as f64 / n).collect()
 }
 
+#[allow(clippy::too_many_arguments)]
 fn panel<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     title: &str,

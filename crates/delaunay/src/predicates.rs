@@ -17,7 +17,7 @@ pub(crate) fn in_sphere_sos(t: [u32; 4], p: [P3; 4], ie: u32, e: P3) -> bool {
     // Corners by id, largest first; `e` among them as index 4.
     let mut order = [0usize, 1, 2, 3, 4];
     let id = |k: usize| if k == 4 { ie } else { t[k] };
-    order.sort_unstable_by(|&x, &y| id(y).cmp(&id(x)));
+    order.sort_unstable_by_key(|&x| std::cmp::Reverse(id(x)));
     for &k in &order {
         if k == 4 {
             // The query has the largest perturbation left: outside.

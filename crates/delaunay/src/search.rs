@@ -255,7 +255,7 @@ impl Search {
     fn pick(&self) -> Option<([u32; 3], Vec<u32>)> {
         let mut best: Option<(&[u32; 3], &Entry)> = None;
         for (k, e) in &self.front {
-            if best.map_or(true, |(_, b)| e.cands.len() < b.cands.len()) {
+            if best.is_none_or(|(_, b)| e.cands.len() < b.cands.len()) {
                 best = Some((k, e));
                 if e.cands.len() <= 1 {
                     break;
@@ -515,7 +515,7 @@ impl Search {
                     })
                     .count();
                 let score = (helps, usize::MAX - kills, sees);
-                if best.map_or(true, |(b, _)| score > b) {
+                if best.is_none_or(|(b, _)| score > b) {
                     best = Some((score, q));
                 }
             }

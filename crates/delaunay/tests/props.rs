@@ -30,7 +30,7 @@ fn sphere_points(n: usize, seed: u64) -> Vec<P3> {
     (0..n)
         .map(|_| {
             let z: f64 = 2.0 * next() - 1.0;
-            let t = 6.283185307179586 * next();
+            let t = std::f64::consts::TAU * next();
             let r = (1.0 - z * z).sqrt();
             [r * t.cos(), r * t.sin(), z]
         })

@@ -375,7 +375,7 @@ impl<'m> Improver<'m> {
 
     /// The best face swap or edge removal around tet `t` for the
     /// dihedral angles: kept when it leaves fewer tets under 10° and no
-    /// smaller min dihedral ([`Work::eval_count_swap`]).
+    /// smaller min dihedral (`Work::eval_count_swap`).
     pub fn swap_for_dihedral(&mut self, t: u32) -> Outcome {
         if t as usize >= self.w.m.tets.len() || !self.w.alive(t) {
             return Outcome::NotFound;
@@ -385,7 +385,7 @@ impl<'m> Improver<'m> {
     }
 
     /// The face swap or edge removal around tet `t` that lifts its
-    /// cavity's min dihedral most ([`Work::eval_lift_swap`]).
+    /// cavity's min dihedral most (`Work::eval_lift_swap`).
     pub fn swap_for_min_dihedral(&mut self, t: u32) -> Outcome {
         if t as usize >= self.w.m.tets.len() || !self.w.alive(t) {
             return Outcome::NotFound;

@@ -4,7 +4,7 @@
 //! pass 3 from lower ones, pass 4 serial) and the redistribution of the
 //! pieces.
 //!
-//! Every part keeps its own points, tets and front ([`Part`] is private to
+//! Every part keeps its own points, tets and front (`Part` is private to
 //! this module and only ever touched by the closure of its own part); parts
 //! see each other's data only through the messages of a [`Comm`].
 

@@ -665,7 +665,7 @@ impl<'a> Front<'a> {
             // give up.
             let due = self.opts.fill_after > 0
                 && self.relax >= self.opts.fill_after
-                && self.relax % self.opts.fill_after == 0;
+                && self.relax.is_multiple_of(self.opts.fill_after);
             if self.opts.fill && (give_up || due) {
                 if self.fill_stalled(self.opts.fill_growth) {
                     continue;
@@ -792,7 +792,8 @@ impl<'a> Front<'a> {
             };
             self.close_or_open(w, fr, found);
         }
-        if self.opts.progress_every > 0 && self.stats.tets % self.opts.progress_every == 0 {
+        if self.opts.progress_every > 0 && self.stats.tets.is_multiple_of(self.opts.progress_every)
+        {
             if let Some(p) = &self.opts.progress {
                 p.set(
                     self.stats.tets as u64,
