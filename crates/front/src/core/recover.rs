@@ -35,7 +35,6 @@ impl<'a> Front<'a> {
                 return;
             }
         }
-        let layers = 1;
         // Later rounds take less: only tets on an edge of the stuck faces'
         // points, so that one stubborn pocket does not undo the rest.
         let need = if self.relax >= 2 {
@@ -49,23 +48,14 @@ impl<'a> Front<'a> {
                 mark[p as usize] = true;
             }
         }
-        let mut removed = Vec::new();
-        for _ in 0..layers {
-            let mut layer = Vec::new();
-            for (t, tv) in self.tets.iter().enumerate() {
-                if self.talive[t] && tv.iter().filter(|&&p| mark[p as usize]).count() >= need {
-                    layer.push(t as u32);
-                }
-            }
-            for &t in &layer {
-                self.talive[t as usize] = false;
-            }
-            for &t in &layer {
-                for &p in &self.tets[t as usize] {
-                    mark[p as usize] = true;
-                }
-            }
-            removed.extend(layer);
+        let removed: Vec<u32> = (0..self.tets.len() as u32)
+            .filter(|&t| {
+                let tv = self.tets[t as usize];
+                self.talive[t as usize] && tv.iter().filter(|&&p| mark[p as usize]).count() >= need
+            })
+            .collect();
+        for &t in &removed {
+            self.talive[t as usize] = false;
         }
         for &t in &removed {
             self.unlink_tet(t);
