@@ -567,6 +567,13 @@ fn print_summary(sum: &Summary) {
             sum.fill_tets
         );
     }
+    if !sum.regions_filled.is_empty() {
+        println!(
+            "warning: the front could not close region{} {:?}: filled whole by the constrained fill of its surface (valid, but its tets follow the surface, not the size field)",
+            if sum.regions_filled.len() == 1 { "" } else { "s" },
+            sum.regions_filled
+        );
+    }
     if let Some(m) = peak_memory_bytes() {
         println!(
             "peak memory: {:.1} MiB ({:.0} bytes/tet)",

@@ -174,6 +174,11 @@ pub struct Summary {
     /// and the tets the fill made (issue 20).
     pub cavities_filled: usize,
     pub fill_tets: usize,
+    /// Regions the front could not close at all, filled whole by the
+    /// constrained fill of their surface instead: valid, but coarse (their
+    /// tets follow the surface, not the size field). Ids as in `Front`
+    /// errors.
+    pub regions_filled: Vec<usize>,
     /// Shells (ids as `parafront check` prints them) oriented as inner
     /// bodies and meshed as voids, without `regions`.
     pub voided_shells: Vec<usize>,
@@ -395,7 +400,7 @@ fn serial_region(
     let field = |p| sizing.size(p);
     let (points, point_size) = region_points(s, sizing, rf);
     let input = FrontInput {
-        points,
+        points: points.clone(),
         point_size,
         faces: rf.faces.clone(),
     };
@@ -409,11 +414,38 @@ fn serial_region(
             fill_after: opts.fill_after,
             ..FrontOptions::default()
         },
-    )
-    .map_err(|e| MeshError::Front {
-        region: rf.region_id as usize,
-        source: e,
-    })?;
+    );
+    let res = match res {
+        Ok(r) => r,
+        // The front could not close the region: the constrained fill of its
+        // whole surface (valid, coarse), unless a debug dump was asked for.
+        Err(e @ FrontError::Stuck { .. }) if !opts.debug_partial => {
+            let region = rf.region_id as usize;
+            let fill = parafront_delaunay::fill_cavity(
+                &points,
+                &rf.faces,
+                &parafront_delaunay::FillOptions::default(),
+            )
+            .map_err(|_| MeshError::Front { region, source: e })?;
+            tracing::warn!(
+                region,
+                tets = fill.tets.len(),
+                "the front could not close the region: filled whole by the constrained fill"
+            );
+            let mut all = points;
+            all.extend_from_slice(&fill.steiner);
+            append_region(mesh, rf, &all, &fill.tets);
+            sum.regions_filled.push(region);
+            sum.fill_tets += fill.tets.len();
+            return Ok(());
+        }
+        Err(e) => {
+            return Err(MeshError::Front {
+                region: rf.region_id as usize,
+                source: e,
+            })
+        }
+    };
     append_region(mesh, rf, &res.points, &res.tets);
     sum.recovery_rounds += res.stats.recovery_rounds;
     sum.tets_removed += res.stats.tets_removed;

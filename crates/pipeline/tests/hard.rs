@@ -195,15 +195,31 @@ fn thin_slots() {
     }
 }
 
-/// Open in issue 20: under a size 10 times the slot's width the front
-/// stalls beside the slot in thin, folded, nearly flat cavities (tets on
-/// their points have 6V ~ 1e-4 of the slot's scale) that neither the
-/// recovery by flips nor the search closes; the front gives up after 4
-/// failed fills (about 25 s) with a clear error.
+/// Under a size 10 times the slot's width the front stalls beside the slot
+/// in thin, folded, nearly flat cavities (6V ~ 1e-4 of the slot's scale)
+/// that neither the flips nor the search close; after two failed fills the
+/// pipeline fills the whole region from its surface (valid, coarse). The
+/// 0.1 % slot at size 0.01 is a run of minutes (a million-tet front before
+/// it stalls): ignored for CI; `slot_under_ten_times_its_width` is the
+/// quick case.
 #[test]
-#[ignore = "issue 20: the fill does not close the slot's flat cavities yet"]
+#[ignore = "minutes: a million-tet front before the region fill (run with --ignored)"]
 fn thin_slots_under_a_large_size() {
     for gap in [1e-2, 1e-3] {
         meshes(&format!("slot {gap}"), &slotted_box(gap));
     }
+}
+
+#[test]
+fn slot_under_ten_times_its_width() {
+    // The front cannot close it: the region is filled whole, and the mesh
+    // is valid.
+    let s = slotted_box(1e-2);
+    let mut o = MeshOptions::default();
+    o.size.h = Some(0.1);
+    let (m, sum) = mesh_surface(&s, &o).expect("the slot meshes");
+    m.check_against_surface(&s.tris).expect("valid");
+    assert_eq!(sum.regions_filled, vec![1], "the whole-region fill ran");
+    let v = s.signed_volume();
+    assert!((m.volume() - v).abs() <= 1e-9 * v);
 }

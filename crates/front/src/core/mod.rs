@@ -61,8 +61,9 @@ pub const MAX_GROWTH_PER_TET: f64 = 2.0;
 pub const DEFAULT_FILL_AFTER: u32 = 4;
 /// Fills that leave a cavity open before the front gives up: each costs
 /// seconds on a front that has them (a slot under 10 times its width took
-/// minutes of recovery and fill rounds before this bound).
-const FILL_TRIES: u32 = 4;
+/// minutes of recovery and fill rounds before this bound; the pipeline then
+/// fills the whole region).
+const FILL_TRIES: u32 = 2;
 
 const NONE: u32 = u32::MAX;
 /// How far a new point keeps from front faces, in sizes, by round.
