@@ -25,6 +25,13 @@ fn mesh_file(file: &str) {
         .check_against_surface(&s.tris)
         .unwrap_or_else(|e| panic!("{file}: invalid mesh: {e}"));
     let _ = stats;
+    // The front (with its cavity fills) closes every corpus part: the
+    // coarse whole-region fill is a last resort, not the mesher.
+    assert!(
+        summary.regions_filled.is_empty(),
+        "{file}: regions filled whole: {:?}",
+        summary.regions_filled
+    );
     println!(
         "{file}: {} tets, front {:.2} s, {} recovery rounds",
         m.tets.len(),
@@ -85,5 +92,6 @@ fn round_tube_thin_wall() {
     let (m, summary) = mesh_surface(&s, &MeshOptions::default()).expect("round.stl meshes");
     m.check_against_surface(&s.tris).expect("valid");
     assert!(summary.cavities_filled > 0, "the fill closed it");
+    assert!(summary.regions_filled.is_empty());
     assert!(summary.fill_tets > 0);
 }
