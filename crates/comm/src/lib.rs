@@ -7,6 +7,7 @@
 //! `[dst]` is what part `dst` receives. An MPI backend implements the same
 //! trait with each rank holding only its own entry; [`Threads`] moves the
 //! buffers between parts that live in one address space.
+#![forbid(unsafe_code)]
 
 /// Collectives over `parts()` parts.
 pub trait Comm: Sync {

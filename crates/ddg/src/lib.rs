@@ -3,6 +3,7 @@
 //! fine tets each DDG tet will hold, the balanced split into parts
 //! (§6, step 2), the shifted partitions of passes 2 and 3 and the region
 //! filter of one part (§7).
+#![forbid(unsafe_code)]
 
 mod field;
 mod locate;

@@ -17,6 +17,7 @@
 //! with exact validity and no quality rules that can step back, adding
 //! Steiner points strictly inside the cavity at its dead ends), then Steiner
 //! points in the triangulation.
+#![forbid(unsafe_code)]
 mod check;
 mod fill;
 mod flips;

@@ -2,6 +2,7 @@
 //! axis-aligned boxes. Everything above it (surface checks, the front's
 //! crossing tests, the mesh `check()`) decides topology only through the
 //! exact predicates here, never through a float tolerance.
+#![forbid(unsafe_code)]
 
 pub mod aabb;
 pub mod intersect;

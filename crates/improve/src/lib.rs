@@ -24,6 +24,7 @@
 //! constraints: nothing swaps across them and their points never move.
 //! Everything is serial and in index order, so the result is determined
 //! by the input.
+#![forbid(unsafe_code)]
 
 mod insert;
 mod ops;

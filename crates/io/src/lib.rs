@@ -14,6 +14,7 @@
 //! regions and patch tags travel as VTU `region`/`patch` cell data, Gmsh
 //! named physical groups (from 1: tags shifted by 1 when one is 0) and
 //! Medit refs.
+#![forbid(unsafe_code)]
 
 mod atomic;
 mod medit;

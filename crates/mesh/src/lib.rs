@@ -12,6 +12,7 @@
 //! - `check`, `check_against_surface`: all invariants, exact orientation.
 //! - [`quality`]: dihedral angles, radius and mean ratio, edge length vs size.
 //! - [`generate`]: structured box meshes for tests.
+#![forbid(unsafe_code)]
 
 mod adjacency;
 mod check;

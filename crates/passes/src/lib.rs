@@ -7,6 +7,7 @@
 //! Every part keeps its own points, tets and front (`Part` is private to
 //! this module and only ever touched by the closure of its own part); parts
 //! see each other's data only through the messages of a [`Comm`].
+#![forbid(unsafe_code)]
 
 mod ddg_build;
 mod pockets;

@@ -2,6 +2,7 @@
 //! region at a time -> checked `TetMesh`. Later stages (DDG, parallel
 //! passes, redistribution, improvement) slot in between the front and the
 //! check. The CLI is a thin layer over [`mesh_surface`].
+#![forbid(unsafe_code)]
 
 mod regions;
 

@@ -14,6 +14,7 @@
 //! any number of threads query it at once. The front (AF4) should keep a
 //! [`SizeCursor`] per thread and call [`Sizing::size_with`]: queries near the
 //! previous one then skip the octree descent and the tet search.
+#![forbid(unsafe_code)]
 
 pub mod background;
 pub mod growth;

@@ -6,6 +6,7 @@
 //!   self-intersection checks, and how the closed shells nest.
 //! - [`heal`]: merges the vertices a float rounding split apart, where
 //!   that closes open edges (opt-in; exact welding stays the default).
+#![forbid(unsafe_code)]
 
 pub mod generate;
 pub mod heal;
