@@ -11,7 +11,7 @@
 //! Dihedral angles are the point here, not the mean ratio: a needle tet
 //! (a short edge, the other points far) can have good dihedral angles but
 //! has a low mean ratio. A candidate is kept only when the cavity ends
-//! with fewer tets under [`BAD_DEG`] and a min dihedral no lower; or, for
+//! with fewer tets under [`SMALL_DIHEDRAL`] and a min dihedral no lower; or, for
 //! a tet under [`LIFT_DEG`], when the cavity's min dihedral rises.
 use crate::ops::{positive, Cand, MARGIN};
 use crate::quality::{min_dihedral_deg, quality};
@@ -20,12 +20,12 @@ use parafront_geom::{cross, dist2, norm, sub, P3};
 use parafront_mesh::quality::TET_EDGES;
 use parafront_mesh::{PointId, TET_FACES};
 
-/// A tet with a min dihedral under this many degrees is bad (the issue's
-/// measure).
-pub(crate) const BAD_DEG: f64 = 10.0;
+/// A tet with a min dihedral under this many degrees is bad: the quality
+/// report's threshold.
+pub(crate) use parafront_mesh::quality::SMALL_DIHEDRAL;
 /// Tets under this min dihedral (degrees) may get a point that only lifts
 /// the min dihedral of their cavity, even at the cost of more tets under
-/// [`BAD_DEG`] (the worst tet is the first criterion).
+/// [`SMALL_DIHEDRAL`] (the worst tet is the first criterion).
 pub(crate) const LIFT_DEG: f64 = 0.1;
 /// The min dihedral (degrees) a lift aims at before it minds the count.
 pub(crate) const LIFT_GOAL: f64 = 0.2;
@@ -47,7 +47,7 @@ pub(crate) struct InsScratch {
     pts: Vec<PointId>,
 }
 
-/// How good a star is: tets under [`BAD_DEG`], summed shortfall below
+/// How good a star is: tets under [`SMALL_DIHEDRAL`], summed shortfall below
 /// 12° (what the search minimises after the count), min dihedral and min
 /// mean ratio.
 #[derive(Clone, Copy, Debug)]
@@ -69,13 +69,13 @@ impl Score {
 
     /// Adds a tet of min dihedral `d` and mean ratio `q`.
     fn add(&mut self, d: f64, q: f64) {
-        self.under += usize::from(d < BAD_DEG);
+        self.under += usize::from(d < SMALL_DIHEDRAL);
         self.short += (12.0 - d).max(0.0);
         self.dmin = self.dmin.min(d);
         self.qmin = self.qmin.min(q);
     }
 
-    /// What the search minimises: the count under [`BAD_DEG`] then the
+    /// What the search minimises: the count under [`SMALL_DIHEDRAL`] then the
     /// shortfall; with `lift` (a tet under [`LIFT_DEG`]) first the min
     /// dihedral up to [`LIFT_GOAL`].
     /// Relative to the cavity's tets before (`old`), so that cavities of
@@ -200,7 +200,7 @@ impl Work<'_> {
     /// Evaluates inserting a point around bad tet `t`; on success `c`
     /// holds the replacement (the new point's id is `m.points.len()`) and
     /// the point's position is returned. `lift`: the min dihedral to aim
-    /// at first (`None`: the count under [`BAD_DEG`]).
+    /// at first (`None`: the count under [`SMALL_DIHEDRAL`]).
     pub(crate) fn eval_insert(
         &self,
         t: u32,
@@ -296,7 +296,7 @@ impl Work<'_> {
             || (lift.is_some()
                 && sc.dmin > old.dmin * (1.0 + MARGIN) + 1e-9
                 // A lift above the bad angle leaves none under it.
-                && lift.is_none_or(|g| g <= BAD_DEG || sc.dmin >= BAD_DEG));
+                && lift.is_none_or(|g| g <= SMALL_DIHEDRAL || sc.dmin >= SMALL_DIHEDRAL));
         if !ok {
             return Err(Outcome::NotBetter);
         }
@@ -323,7 +323,7 @@ impl Work<'_> {
     }
 }
 
-/// Cost of a new tet for the count swaps: 1000 if under [`BAD_DEG`],
+/// Cost of a new tet for the count swaps: 1000 if under [`SMALL_DIHEDRAL`],
 /// plus its shortfall below 12°; `None` when not positive. Also its min
 /// dihedral.
 fn cost(x: [P3; 4]) -> Option<(f64, f64)> {
@@ -331,14 +331,14 @@ fn cost(x: [P3; 4]) -> Option<(f64, f64)> {
         return None;
     }
     let d = min_dihedral_deg(x);
-    let bad = if d < BAD_DEG { 1000.0 } else { 0.0 };
+    let bad = if d < SMALL_DIHEDRAL { 1000.0 } else { 0.0 };
     Some((bad + (12.0 - d).max(0.0), d))
 }
 
 impl Work<'_> {
     /// Swaps for the dihedral count (§9.1's 2-3 and edge removal, judged
     /// as the insertion is): the best of the 4 face swaps and 6 edge
-    /// removals of tet `t` that leaves fewer tets under [`BAD_DEG`] and a
+    /// removals of tet `t` that leaves fewer tets under [`SMALL_DIHEDRAL`] and a
     /// min dihedral no lower. Edge removal takes the triangulation of the
     /// ring with the least summed cost (Klincsek's programme on a sum).
     pub(crate) fn eval_count_swap(
@@ -365,7 +365,7 @@ impl Work<'_> {
                 match cost(self.pts(nv)) {
                     Some((k, dd)) => {
                         sum += k;
-                        under += usize::from(dd < BAD_DEG);
+                        under += usize::from(dd < SMALL_DIHEDRAL);
                         dmin = dmin.min(dd);
                     }
                     None => ok = false,
@@ -409,8 +409,8 @@ impl Work<'_> {
                         if sum < bk.0 {
                             let under = l.2
                                 + rr.2
-                                + usize::from(t1.1 < BAD_DEG)
-                                + usize::from(t2.1 < BAD_DEG);
+                                + usize::from(t1.1 < SMALL_DIHEDRAL)
+                                + usize::from(t2.1 < SMALL_DIHEDRAL);
                             bk = (sum, k, under, l.3.min(rr.3).min(t1.1).min(t2.1));
                         }
                     }
@@ -441,7 +441,7 @@ impl Work<'_> {
     /// Swaps that lift the min dihedral (§9.1's 2-3 and edge removal):
     /// the best of tet `t`'s 4 face swaps and 6 edge removals by the
     /// cavity's min dihedral, kept when it is higher than before and at
-    /// least [`BAD_DEG`] (the count passes see to the tets under it). Edge
+    /// least [`SMALL_DIHEDRAL`] (the count passes see to the tets under it). Edge
     /// removal takes the ring's max-min triangulation (Klincsek's
     /// programme on the min). Where every point is on the surface (a plate
     /// one size thick) swaps are all that can raise it.
@@ -465,7 +465,7 @@ impl Work<'_> {
                 .iter()
                 .map(|&nv| d_of(self.pts(nv)).unwrap_or(f64::NEG_INFINITY))
                 .fold(f64::INFINITY, f64::min);
-            if dmin > old && dmin >= BAD_DEG && dmin > best {
+            if dmin > old && dmin >= SMALL_DIHEDRAL && dmin > best {
                 best = dmin;
                 c.set(&[t, nt], new);
                 found = Outcome::Done;
@@ -507,7 +507,7 @@ impl Work<'_> {
                 }
             }
             let dmin = dp[0][n - 1].0;
-            if !(dmin > old && dmin >= BAD_DEG && dmin > best) {
+            if !(dmin > old && dmin >= SMALL_DIHEDRAL && dmin > best) {
                 continue;
             }
             best = dmin;

@@ -176,8 +176,9 @@ const FINAL_SWAP: f64 = 0.8;
 const DIHEDRAL_POLISH: f64 = 1.0;
 /// The share of the ball's worst mean ratio that polish may give up.
 const DIHEDRAL_KEEP: f64 = 0.9;
-/// tan(10°), for [`quality::has_dihedral_under`].
-const TAN_BAD: f64 = 0.176_326_980_708_464_98;
+/// tan(`SMALL_DIHEDRAL`) (10°), for [`quality::has_dihedral_under`]; a
+/// test holds them together.
+const TAN_SMALL_DIHEDRAL: f64 = 0.176_326_980_708_464_98;
 /// Rounds of point insertion.
 const INSERT_ROUNDS: usize = 3;
 /// Rounds of insertion that lift the tets under 0.1°, after those.
@@ -465,7 +466,7 @@ impl<'m> Improver<'m> {
             let bad = self.under_deg(if lift {
                 insert::LIFT_DEG
             } else {
-                insert::BAD_DEG
+                insert::SMALL_DIHEDRAL
             });
             if bad.is_empty() && round == 0 {
                 break; // none under 10°, so none under 0.1°
@@ -518,7 +519,7 @@ impl<'m> Improver<'m> {
     fn count_swap_pass(&mut self, st: &mut ImproveStats) {
         let t0 = Instant::now();
         for _round in 0..INSERT_ROUNDS {
-            let bad = self.under_deg(insert::BAD_DEG);
+            let bad = self.under_deg(insert::SMALL_DIHEDRAL);
             let mut changed = 0;
             for (d0, t) in bad {
                 if !self.unchanged(t, d0) {
@@ -543,7 +544,8 @@ impl<'m> Improver<'m> {
         if self.w.dok[t as usize] {
             return false;
         }
-        let bad = quality::has_dihedral_under(self.w.pts(self.w.m.tets[t as usize]), TAN_BAD);
+        let bad =
+            quality::has_dihedral_under(self.w.pts(self.w.m.tets[t as usize]), TAN_SMALL_DIHEDRAL);
         self.w.dok[t as usize] = !bad;
         bad
     }
@@ -569,7 +571,7 @@ impl<'m> Improver<'m> {
     /// selective movement.
     fn count_pass(&mut self, st: &mut ImproveStats) {
         let t0 = Instant::now();
-        let bad = self.under_deg(insert::BAD_DEG);
+        let bad = self.under_deg(insert::SMALL_DIHEDRAL);
         let mut seen = vec![false; self.w.m.points.len()];
         for (_, t) in bad {
             for p in self.w.m.tets[t as usize] {
@@ -776,5 +778,14 @@ impl<'m> Improver<'m> {
             }
         }
         st.selective.seconds += t0.elapsed().as_secs_f64();
+    }
+}
+
+#[cfg(test)]
+mod tan_tests {
+    #[test]
+    fn tan_small_dihedral_is_tan_of_the_threshold() {
+        let t = parafront_mesh::quality::SMALL_DIHEDRAL.to_radians().tan();
+        assert!((t - super::TAN_SMALL_DIHEDRAL).abs() <= 1e-16, "{t}");
     }
 }
