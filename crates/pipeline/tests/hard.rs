@@ -237,7 +237,7 @@ fn boss_box(e: f64) -> Surface {
     }
     let c = |x: u32, y: u32, z: u32| x + 2 * y + 4 * z;
     let mut t: Vec<[u32; 3]> = Vec::new();
-    let mut quad = |t: &mut Vec<[u32; 3]>, a: u32, b: u32, cc: u32, d: u32| {
+    let quad = |t: &mut Vec<[u32; 3]>, a: u32, b: u32, cc: u32, d: u32| {
         t.push([a, b, cc]);
         t.push([a, cc, d]);
     };
