@@ -495,3 +495,33 @@ fn a_capped_growth_is_the_capped_field_and_smaller() {
         }
     }
 }
+
+/// Seeds at or above the cap are dropped, but the growth still covers the
+/// surface's box: a small feature's seeds alone once made the tree, and a
+/// point outside it got the feature's size (a unit box with a 1e-4 boss
+/// under a size of 0.5 was meshed at 1e-4 everywhere).
+#[test]
+fn capped_growth_covers_the_dropped_seeds_box() {
+    use parafront_size::SurfaceGrowth;
+    let mut seeds = vec![([0.0, 0.0, 0.0], 1.1), ([1.0, 1.0, 1.0], 1.1)];
+    for k in 0..8 {
+        let d = |b: usize| if k >> b & 1 == 1 { 1e-4 } else { 0.0 };
+        seeds.push(([0.5 + d(0), 0.5 + d(1), 1.0 + d(2)], 1e-4));
+    }
+    let capped = SurfaceGrowth::with_cap(&seeds, 0.2, 0.5);
+    let free = SurfaceGrowth::with_cap(&seeds, 0.2, f64::INFINITY);
+    for p in [
+        [0.0, 0.0, 0.0],
+        [0.5, 0.5, 0.5],
+        [1.0, 0.0, 1.0],
+        [0.9, 0.9, 0.1],
+    ] {
+        let want = free.size(p).min(0.5);
+        let got = capped.size(p);
+        assert!(
+            (got - want).abs() <= 1e-9 * want,
+            "at {p:?}: {got} vs {want}"
+        );
+        assert!(got > 0.05, "at {p:?}: {got}");
+    }
+}
