@@ -401,7 +401,7 @@ fn serial_region(
     let field = |p| sizing.size(p);
     let (points, point_size) = region_points(s, sizing, rf);
     let input = FrontInput {
-        points: points.clone(),
+        points,
         point_size,
         faces: rf.faces.clone(),
     };
@@ -422,6 +422,9 @@ fn serial_region(
         // whole surface (valid, coarse), unless a debug dump was asked for.
         Err(e @ FrontError::Stuck { .. }) if !opts.debug_partial => {
             let region = rf.region_id as usize;
+            // The front took the points; this path is rare, so they are
+            // gathered again rather than copied on every run.
+            let (points, _) = region_points(s, sizing, rf);
             let fill = parafront_delaunay::fill_cavity(
                 &points,
                 &rf.faces,
