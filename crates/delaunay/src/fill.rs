@@ -4,7 +4,7 @@
 //! point (a star-shaped cavity); the search (`search.rs`); Steiner points
 //! strictly inside it in the triangulation, under other perturbations.
 //! Every result is verified exactly.
-use crate::flips::key3;
+use crate::flips::{key3, same_cycle};
 use crate::recover::{crossings, recover_all};
 use crate::search::search_fill;
 use crate::tri::{InsertError, Triangulation, NONE, TET_FACES};
@@ -312,9 +312,7 @@ fn classify(tri: &Triangulation, cf: &[[u32; 3]]) -> Option<Vec<u32>> {
             let w = TET_FACES[k].map(|j| tv[j]);
             let f = *oriented.get(&key3(w))?;
             // The tet's outward face is the cavity face reversed.
-            let r = [f[0], f[2], f[1]];
-            let same = (0..3).any(|s| [r[s], r[(s + 1) % 3], r[(s + 2) % 3]] == w);
-            if !same || !seen.insert(key3(w)) {
+            if !same_cycle([f[0], f[2], f[1]], w) || !seen.insert(key3(w)) {
                 return None;
             }
         }
@@ -406,33 +404,38 @@ fn steiner_near(tri: &Triangulation, cf: &[[u32; 3]], m: usize) -> Option<P3> {
             size = size.max(parafront_geom::dist(pt(v), c));
         }
     }
-    let mut planes: Vec<(P3, P3)> = near
+    let planes: Vec<(P3, P3)> = near
         .iter()
         .map(|&i| {
             let p = cf[i].map(pt);
             (centroid3(p[0], p[1], p[2]), tri_normal(p[0], p[1], p[2]))
         })
         .collect();
-    for k in 0..3 {
-        let mut n = [0.0; 3];
-        n[k] = 1.0;
-        let mut lo = c;
-        lo[k] -= size;
-        planes.push((lo, n));
-        n[k] = -1.0;
-        let mut hi = c;
-        hi[k] += size;
-        planes.push((hi, n));
-    }
-    let (q, depth) = deepest_point(&planes)?;
-    if !(depth > 0.0) {
-        return None;
-    }
+    let q = deepest_in_box(planes, c, size)?;
     let sees = near.iter().all(|&i| {
         let p = cf[i].map(pt);
         orient3d(p[0], p[1], p[2], q) > 0.0
     });
     (sees && inside(tri, cf, q)).then_some(q)
+}
+
+/// The deepest point of the half-spaces `planes` (point, inward normal)
+/// within the box of half-width `half` about `c`, where it lies strictly
+/// inside them all.
+pub(crate) fn deepest_in_box(mut planes: Vec<(P3, P3)>, c: P3, half: f64) -> Option<P3> {
+    for k in 0..3 {
+        let mut n = [0.0; 3];
+        n[k] = 1.0;
+        let mut lo = c;
+        lo[k] -= half;
+        planes.push((lo, n));
+        n[k] = -1.0;
+        let mut hi = c;
+        hi[k] += half;
+        planes.push((hi, n));
+    }
+    let (q, depth) = deepest_point(&planes)?;
+    (depth > 0.0 && q.iter().all(|x| x.is_finite())).then_some(q)
 }
 
 /// Whether `q` lies strictly inside the closed surface `cf`.

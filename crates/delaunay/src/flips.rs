@@ -24,6 +24,13 @@ pub(crate) fn key3(mut w: [u32; 3]) -> [u32; 3] {
     w
 }
 
+/// Whether `a` and `b` are the same oriented triangle (one a rotation of
+/// the other).
+#[inline]
+pub(crate) fn same_cycle(a: [u32; 3], b: [u32; 3]) -> bool {
+    a == b || a == [b[1], b[2], b[0]] || a == [b[2], b[0], b[1]]
+}
+
 impl Triangulation {
     /// Replace the live tets `old` (which must form a region) by `new`
     /// (positive tets covering the same region), relinking the faces.

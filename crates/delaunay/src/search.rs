@@ -7,11 +7,10 @@
 //! inside the cavity, seeing the faces that had no apex, joins the points
 //! and the search starts again (the twisted prisms that have no
 //! tetrahedralization of their own points need one).
-use crate::flips::key3;
+use crate::flips::{key3, same_cycle};
 use crate::tri::TET_FACES;
 use parafront_geom::{
-    centroid3, dist, intersect::triangles_intersect, kernel::deepest_point, orient3d, tri_normal,
-    Aabb, P3,
+    centroid3, dist, intersect::triangles_intersect, orient3d, tri_normal, Aabb, P3,
 };
 use std::collections::BTreeMap;
 
@@ -417,7 +416,7 @@ impl Search {
             let w = tf.map(|j| tv[j]);
             if let Some(e) = self.front.get(&key3(w)) {
                 // A face the tet closes lies the other way round.
-                if e.face == w || e.face == [w[1], w[2], w[0]] || e.face == [w[2], w[0], w[1]] {
+                if same_cycle(e.face, w) {
                     return false;
                 }
             }
@@ -440,7 +439,7 @@ impl Search {
             let f = tf.map(|j| t[j]);
             if key3(f) == key3(w) {
                 // The same face: only from its other side.
-                return !(w == f || w == [f[1], f[2], f[0]] || w == [f[2], f[0], f[1]]);
+                return !same_cycle(w, f);
             }
             !self.meet(f, w)
         })
@@ -534,8 +533,7 @@ impl Search {
         let lmax = (0..3)
             .map(|e| dist(fp[e], fp[(e + 1) % 3]))
             .fold(0.0, f64::max);
-        let mut out = Vec::new();
-        let mut planes: Vec<(P3, P3)> = self
+        let planes: Vec<(P3, P3)> = self
             .front
             .values()
             .filter(|e| e.face.iter().any(|v| face.contains(v)))
@@ -544,22 +542,9 @@ impl Search {
                 (centroid3(p[0], p[1], p[2]), tri_normal(p[0], p[1], p[2]))
             })
             .collect();
-        for k in 0..3 {
-            let mut d = [0.0; 3];
-            d[k] = 1.0;
-            let mut lo = c;
-            lo[k] -= lmax;
-            planes.push((lo, d));
-            d[k] = -1.0;
-            let mut hi = c;
-            hi[k] += lmax;
-            planes.push((hi, d));
-        }
-        if let Some((q, depth)) = deepest_point(&planes) {
-            if depth > 0.0 && q.iter().all(|x| x.is_finite()) {
-                out.push(q);
-            }
-        }
+        let mut out: Vec<P3> = crate::fill::deepest_in_box(planes, c, lmax)
+            .into_iter()
+            .collect();
         for s in [0.5, 0.25, 0.1, 0.03, 0.01, 1e-3, 1e-4] {
             out.push(parafront_geom::add(c, parafront_geom::scale(n, s * lmax)));
         }
