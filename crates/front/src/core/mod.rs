@@ -59,10 +59,11 @@ pub const MAX_GROWTH_PER_TET: f64 = 2.0;
 /// closes round.stl in 6 s where 10 took 6 s and 200 failed; 1 and 2 fill
 /// larger, harder cavities (the tray takes 40-70 s).
 pub const DEFAULT_FILL_AFTER: u32 = 4;
-/// Fills that leave a cavity open before the front gives up: each costs
-/// seconds on a front that has them (a slot under 10 times its width took
-/// minutes of recovery and fill rounds before this bound; the pipeline then
-/// fills the whole region).
+/// Fills every `fill_after` rounds that leave a cavity open before the
+/// front gives up (after one more recovery round and the give-up fill, so
+/// three fills in all): each costs seconds on a front that has them (a slot
+/// under 10 times its width took minutes of recovery and fill rounds before
+/// this bound; the pipeline then fills the whole region).
 const FILL_TRIES: u32 = 2;
 
 const NONE: u32 = u32::MAX;
