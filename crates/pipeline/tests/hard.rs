@@ -197,7 +197,7 @@ fn thin_slots() {
 
 /// Under a size 10 times the slot's width the front stalls beside the slot
 /// in thin, folded, nearly flat cavities (6V ~ 1e-4 of the slot's scale)
-/// that neither the flips nor the search close; after two failed fills the
+/// that neither the flips nor the search close; after three failed fills the
 /// pipeline fills the whole region from its surface (valid, coarse). The
 /// 0.1 % slot at size 0.01 is a run of minutes (a million-tet front before
 /// it stalls): ignored for CI; `slot_under_ten_times_its_width` is the
