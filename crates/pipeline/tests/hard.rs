@@ -171,7 +171,7 @@ fn rod(k: usize, r: f64, len: f64, segs: usize) -> Surface {
 
 #[test]
 fn thin_rod_is_closed_by_the_fill() {
-    // BENCHMARKS.md's rod (r 0.02, length 20, side triangles 5 long:
+    // The thin rod of issue 20 (r 0.02, length 20, side triangles 5 long:
     // aspect 3000): recovery alone never closed it; the fill does.
     let s = rod(8, 0.02, 20.0, 4);
     let (m, sum) = mesh_surface(&s, &MeshOptions::default()).expect("the rod meshes");

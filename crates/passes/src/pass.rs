@@ -1,0 +1,304 @@
+//! One inside-out pass (§7): every front face goes to the part that owns
+//! its points, the parts advance their fronts in parallel on their cells,
+//! and new points get global ids; the seeds of the parts inside the domain,
+//! and the front each DDG tet is left with.
+use super::*;
+
+/// One parallel pass on partition `part_of`: send each front face to the
+/// part that owns its three points, and a copy to every part whose region
+/// box it meets (so that each part knows every face bounding its region);
+/// every part advances its faces; new points get global ids. Returns the
+/// tets and the front seconds of each part.
+pub(crate) fn parallel_pass<C: Comm>(
+    parts: &mut [Part],
+    comm: &C,
+    regions: &dyn Regions,
+    size: Sizes<'_>,
+    pass: u8,
+    next_gid: &mut u32,
+) -> Result<(Vec<usize>, Vec<f64>), PassError> {
+    let np = parts.len();
+    let mut boxes = regions.bounds();
+    boxes.resize(np, Aabb::EMPTY);
+    let boxes: Vec<Aabb> = boxes
+        .iter()
+        .map(|b| {
+            if b.is_empty() {
+                *b
+            } else {
+                b.inflated(1e-9 * b.diagonal())
+            }
+        })
+        .collect();
+
+    // Each holder sorts its faces out.
+    let outboxes: Vec<Vec<(u32, FaceMsg)>> = parts
+        .par_iter_mut()
+        .map(|part| {
+            let mut owner: Vec<Option<Option<u32>>> = vec![None; part.pts.len()];
+            let mut out = Vec::new();
+            let mut keep = Vec::new();
+            for &f in &part.front {
+                let o = f.map(|i| {
+                    *owner[i as usize].get_or_insert_with(|| regions.owner(part.pts[i as usize]))
+                });
+                let own = if o[0].is_some() && o[0] == o[1] && o[1] == o[2] {
+                    o[0]
+                } else {
+                    None
+                };
+                let v = f.map(|i| part.rec(i));
+                let fb = Aabb::from_points(v.iter().map(|r| &r.p));
+                for (q, b) in boxes.iter().enumerate() {
+                    if Some(q as u32) != own && b.overlaps(&fb) {
+                        out.push((q as u32, FaceMsg { owned: false, v }));
+                    }
+                }
+                match own {
+                    Some(k) => out.push((k, FaceMsg { owned: true, v })),
+                    None => keep.push(f),
+                }
+            }
+            part.front = keep;
+            out
+        })
+        .collect();
+    let inboxes = comm.exchange(outboxes);
+
+    // Every part meshes inside its region.
+    let made: Vec<Made> = inboxes
+        .into_par_iter()
+        .enumerate()
+        .map(|(k, inbox)| front_call(inbox, k as u32, regions, size))
+        .collect::<Result<_, (usize, FrontError)>>()
+        .map_err(|(part, source)| PassError::Pass { pass, part, source })?;
+
+    // Global ids for the new points: an all-gather of the counts.
+    let counts = comm.all_gather(
+        made.iter()
+            .map(|m| {
+                m.res
+                    .as_ref()
+                    .map_or(0, |r| r.points.len() - m.input_gid.len()) as u32
+            })
+            .collect(),
+    );
+    let mut base = Vec::with_capacity(np);
+    let mut acc = *next_gid;
+    for c in &counts {
+        base.push(acc);
+        acc += c;
+    }
+    *next_gid = acc;
+    let secs: Vec<f64> = made.iter().map(|m| m.seconds).collect();
+    let tets: Vec<usize> = parts
+        .par_iter_mut()
+        .zip(made)
+        .zip(base)
+        .map(|((part, m), base)| absorb(part, m, base, pass))
+        .collect();
+    Ok((tets, secs))
+}
+
+/// Builds one part's front from its inbox (owned faces first, then the
+/// context) and advances it in pass mode under its region filter.
+pub(crate) fn front_call(
+    inbox: Vec<(u32, FaceMsg)>,
+    k: u32,
+    regions: &dyn Regions,
+    size: Sizes<'_>,
+) -> Result<Made, (usize, FrontError)> {
+    let t0 = Instant::now();
+    if !inbox.iter().any(|m| m.1.owned) {
+        return Ok(Made {
+            res: None,
+            input_gid: Vec::new(),
+            input_ok: Vec::new(),
+            stuck: Vec::new(),
+            seconds: 0.0,
+        });
+    }
+    let n_owned = inbox.iter().filter(|m| m.1.owned).count();
+    // Owned faces first: their points get the low local ids.
+    let (input, gids) = local_front(
+        [true, false]
+            .into_iter()
+            .flat_map(|owned| inbox.iter().filter(move |m| m.1.owned == owned))
+            .map(|(_, m)| &m.v),
+    );
+    let filter = regions.filter(k);
+    let input_ok: Vec<bool> = input
+        .points
+        .iter()
+        .map(|&p| regions.owner(p) == Some(k))
+        .collect();
+    let res = advance(
+        input,
+        SizeMode::Field(size.field),
+        &*filter,
+        &FrontOptions {
+            pass: true,
+            max_growth: size.max_growth,
+            ..FrontOptions::default()
+        },
+    )
+    .map_err(|e| (k as usize, e))?;
+    let t_front = t0.elapsed().as_secs_f64();
+    let mut res = res;
+    let n_in = gids.len();
+    let pocket_tets = close_pockets(
+        &mut res,
+        |i| i as usize >= n_in || input_ok[i as usize],
+        size.field,
+    );
+    let t_pockets = t0.elapsed().as_secs_f64() - t_front;
+    let stuck: Vec<bool> = res
+        .front
+        .iter()
+        .map(|f| is_stuck(&res, *f, &*filter))
+        .collect();
+    if tracing::enabled!(tracing::Level::DEBUG) {
+        tracing::debug!(
+            "part {k}: {} points in, {} owned faces, {} tets, front {t_front:.3} s, pockets {t_pockets:.3} s ({pocket_tets} tets), stuck check {:.3} s",
+            gids.len(),
+            n_owned,
+            res.tets.len(),
+            t0.elapsed().as_secs_f64() - t_front - t_pockets
+        );
+    }
+    Ok(Made {
+        res: Some(res),
+        input_gid: gids,
+        input_ok,
+        stuck,
+        seconds: t0.elapsed().as_secs_f64(),
+    })
+}
+
+/// Pass 1 for the parts that own no face of the input front (those off
+/// the surface, P >= 32 on a ball): their whole region would wait for
+/// pass 2, on one part. Each gets one fine regular tet, inside-out: at the
+/// middle of its DDG tet farthest (in face steps) from its walls, with its
+/// faces facing out as its front. Returns how many parts got one.
+pub(crate) fn seed_inner_parts(
+    parts: &mut [Part],
+    d: &Ddg,
+    loc: &Locator,
+    part0: &[u32],
+    size: &(dyn Fn(P3) -> f64 + Sync),
+    next_gid: &mut u32,
+) -> usize {
+    let np = parts.len();
+    let nt = d.tets.len();
+    // Face steps from a wall or the surface.
+    let mut depth = vec![u32::MAX; nt];
+    let mut queue = std::collections::VecDeque::new();
+    // Parts that own a face of the input front (held by part 0).
+    let mut owns = vec![false; np];
+    let owner: Vec<Option<u32>> = parts[0]
+        .pts
+        .par_iter()
+        .map(|&p| loc.owner(p, part0))
+        .collect();
+    for f in &parts[0].front {
+        let o = f.map(|i| owner[i as usize]);
+        if let Some(k) = o[0] {
+            if o[1] == o[0] && o[2] == o[0] {
+                owns[k as usize] = true;
+            }
+        }
+    }
+    for t in 0..nt {
+        let wall = (0..4).any(|f| {
+            let n = d.neigh[4 * t + f];
+            n == u32::MAX || part0[(n / 4) as usize] != part0[t]
+        });
+        if wall {
+            depth[t] = 0;
+            queue.push_back(t);
+        }
+    }
+    while let Some(t) = queue.pop_front() {
+        for f in 0..4 {
+            let n = d.neigh[4 * t + f];
+            if n != u32::MAX && depth[(n / 4) as usize] == u32::MAX {
+                depth[(n / 4) as usize] = depth[t] + 1;
+                queue.push_back((n / 4) as usize);
+            }
+        }
+    }
+    // Per part without a face, its tets, deepest first.
+    let mut cands: Vec<Vec<usize>> = vec![Vec::new(); np];
+    for t in 0..nt {
+        if !owns[part0[t] as usize] {
+            cands[part0[t] as usize].push(t);
+        }
+    }
+    // Corners of a regular tet of unit edge about the origin.
+    let s = 1.0 / 8f64.sqrt();
+    let corners = [[s, s, s], [s, -s, -s], [-s, s, -s], [-s, -s, s]];
+    // Its faces, facing out of it (the front's faces face the space left).
+    const OUTWARD: [[usize; 3]; 4] = [[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]];
+    let seed_in = |t: usize| -> Option<[P3; 4]> {
+        let c = d.centroid(t);
+        let h = size(c);
+        let mut v = corners.map(|q| [c[0] + h * q[0], c[1] + h * q[1], c[2] + h * q[2]]);
+        if orient3d(v[0], v[1], v[2], v[3]) < 0.0 {
+            v.swap(2, 3);
+        }
+        (v.iter().all(|&p| loc.strictly_holds(t as u32, p))
+            && orient3d(v[0], v[1], v[2], v[3]) > 0.0)
+            .then_some(v)
+    };
+    let mut seeded = 0;
+    for (k, mut ts) in cands.into_iter().enumerate() {
+        ts.sort_by_key(|&t| (std::cmp::Reverse(depth[t]), t));
+        let Some(v) = ts.iter().find_map(|&t| seed_in(t)) else {
+            continue;
+        };
+        let part = &mut parts[k];
+        let ids = v.map(|p| {
+            let gid = *next_gid;
+            *next_gid += 1;
+            part.local(Rec { gid, p, h: size(p) })
+        });
+        part.tets.push(ids);
+        part.tet_pass.push(1);
+        for f in OUTWARD {
+            part.front.push(f.map(|i| ids[i]));
+        }
+        seeded += 1;
+    }
+    seeded
+}
+
+/// Per DDG tet, the front faces left in it (the first tet holding each
+/// face's centroid), summed over the parts.
+pub(crate) fn front_left_per_tet<C: Comm>(
+    parts: &[Part],
+    comm: &C,
+    loc: &Locator,
+    n_tets: usize,
+) -> Vec<u32> {
+    let local: Vec<Vec<u32>> = parts
+        .par_iter()
+        .map(|part| {
+            let mut ts = Vec::with_capacity(part.front.len());
+            for f in &part.front {
+                let [a, b, c] = f.map(|i| part.pts[i as usize]);
+                loc.hosts(centroid3(a, b, c), |t| {
+                    ts.push(t);
+                    false
+                });
+            }
+            ts
+        })
+        .collect();
+    let mut left = vec![0u32; n_tets];
+    for ts in comm.all_gather(local) {
+        for t in ts {
+            left[t as usize] += 1;
+        }
+    }
+    left
+}

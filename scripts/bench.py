@@ -1,0 +1,339 @@
+#!/usr/bin/env python3
+"""Benchmark parafront beside the peers, in one sitting, and write BENCHMARKS.md.
+
+    python3 scripts/bench.py                       # corpus + bench 1e6, writes BENCHMARKS.md
+    python3 scripts/bench.py --sets corpus --repeat 1 --out /tmp/b.md
+    python3 scripts/bench.py --sets bench1e5 --peers gmsh-hxt --threads 1
+
+parafront is timed as a user times it: the whole `parafront mesh` process,
+default options, from start to exit (reading, meshing, improvement, checks,
+writing). Its peak memory is the process's peak RSS. The peers are run by
+../shared/tools/peers/peer_mesh.py (`--h auto`: the mean surface edge, every
+peer keeping the surface), timed over their meshing call with their own
+optimisation. Every parafront mesh is checked by ../shared/tools/meshcheck.py
+against its surface. Times are medians over --repeat runs; compare ratios
+within one file, not across sittings.
+
+Needs: python3 with numpy and meshio (meshcheck), and the peers (pip install
+gmsh tetgen netgen-mesher) unless --peers none. The release binary is built
+if missing.
+"""
+import argparse
+import datetime
+import json
+import os
+import platform
+import re
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+SHARED = os.environ.get("PARAFRONT_SHARED", os.path.join(os.path.dirname(ROOT), "shared"))
+GEOMETRY = os.environ.get("PARAFRONT_GEOMETRY", os.path.join(SHARED, "geometry"))
+
+SETS = {
+    # The corpus: real surfaces (valid/ and dirty/, which mesh with --heal),
+    # and the needle frustum of the CLI's tests.
+    "corpus": [
+        ("valid/1002_tray_bottom.STL", []),
+        ("valid/base_interface_gmsh.stl", []),
+        ("valid/boot.obj", []),
+        ("valid/discrete_voids.obj", []),
+        ("valid/fandisk.off", []),
+        ("valid/fertility.off", []),
+        ("valid/hinge.stl", []),
+        ("valid/plate_holes.STL", []),
+        ("valid/round.stl", []),
+        ("valid/skull.obj", []),
+        ("valid/spot.obj", []),
+        ("dirty/angle_block.STL", ["--heal"]),
+        ("dirty/idler_riser.STL", ["--heal"]),
+        ("@crates/cli/tests/data/needle_frustum.obj", []),
+    ],
+    "bench1e5": [(f"bench/{n}_1e5.stl", []) for n in ["sphere", "torus", "box2holes", "spheres27"]],
+    "bench1e6": [(f"bench/{n}_1e6.stl", []) for n in ["sphere", "torus"]],
+    "bench5e6": [(f"bench/{n}_5e6.stl", []) for n in ["sphere"]],
+}
+
+
+def resolve(rel):
+    if rel.startswith("@"):
+        return os.path.join(ROOT, rel[1:])
+    if rel.startswith("bench/"):
+        return os.path.join(SHARED, rel)
+    return os.path.join(GEOMETRY, rel)
+
+
+def median(xs):
+    xs = [x for x in xs if x is not None]
+    return statistics.median(xs) if xs else None
+
+
+def parse_summary(out):
+    """The numbers of `parafront mesh`'s summary."""
+    r = {}
+    m = re.search(r"^(\d+) tets, (\d+) points", out, re.M)
+    if m:
+        r["tets"] = int(m.group(1))
+        r["points"] = int(m.group(2))
+    m = re.search(r"^seconds: (.*) \(total ([\d.]+), (\d+) threads?\)", out, re.M)
+    if m:
+        r["stages"] = {k: float(v) for k, v in re.findall(r"([a-z ]+) ([\d.]+)", m.group(1))}
+        r["stages"] = {k.strip(): v for k, v in r["stages"].items()}
+        r["total"] = float(m.group(2))
+    m = re.search(r"^quality: min dihedral ([\d.]+) deg, ([\d.]+)% of tets under 10 deg, "
+                  r"mean radius ratio ([\d.]+)", out, re.M)
+    if m:
+        r["min_dih"] = float(m.group(1))
+        r["pct10"] = float(m.group(2))
+        r["rr"] = float(m.group(3))
+    m = re.search(r"^constrained fill: (\d+) cavit\w+ .*?, (\d+) tets", out, re.M)
+    r["fill_cavities"] = int(m.group(1)) if m else 0
+    r["fill_tets"] = int(m.group(2)) if m else 0
+    m = re.search(r"^recovery: (\d+) rounds", out, re.M)
+    r["recovery_rounds"] = int(m.group(1)) if m else 0
+    r["region_fill"] = "filled whole" in out
+    return r
+
+
+def run_parafront(binary, surf, extra, threads, out_mesh):
+    cmd = [binary, "mesh", surf, "-o", out_mesh, "--threads", str(threads)] + extra
+    t0 = time.perf_counter()
+    p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    out, _ = p.communicate()
+    wall = time.perf_counter() - t0
+    r = parse_summary(out)
+    r["ok"] = p.returncode == 0
+    r["wall"] = wall
+    r["log"] = out
+    return r
+
+
+def peak_rss_bytes(binary, surf, extra, threads, out_mesh):
+    """Peak RSS of one run (a separate run: wait4 needs its own child)."""
+    cmd = [binary, "mesh", surf, "-o", out_mesh, "--threads", str(threads)] + extra
+    pid = os.fork()
+    if pid == 0:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, 1)
+        os.dup2(devnull, 2)
+        os.execv(binary, cmd)
+    _, status, ru = os.wait4(pid, 0)
+    return ru.ru_maxrss * 1024 if os.WEXITSTATUS(status) == 0 else None
+
+
+def meshcheck(surf, mesh, healed):
+    cmd = [sys.executable, os.path.join(SHARED, "tools", "meshcheck.py"), "--surface",
+           healed or surf, mesh, "--quiet"]
+    p = subprocess.run(cmd, capture_output=True, text=True)
+    return p.returncode == 0
+
+
+def run_peers(surf, peers, threads, repeat, jsonl):
+    if not peers:
+        return []
+    script = os.path.join(SHARED, "tools", "peers", "peer_mesh.py")
+    rows = []
+    for _ in range(repeat):
+        if os.path.exists(jsonl):
+            os.remove(jsonl)
+        cmd = [sys.executable, script, surf, "--peers", ",".join(peers), "--h", "auto",
+               "--threads", ",".join(map(str, threads)), "--jsonl", jsonl, "--timeout", "600"]
+        # In the scratch folder: TetGen leaves files in its working folder.
+        p = subprocess.run(cmd, capture_output=True, text=True, cwd=os.path.dirname(jsonl))
+        if os.path.exists(jsonl):
+            with open(jsonl) as f:
+                rows += [json.loads(line) for line in f if line.strip()]
+        else:
+            # peer_mesh.py itself failed (e.g. meshio cannot read the file).
+            why = (p.stderr.strip().splitlines() or ["no output"])[-1][:120]
+            return [{"peer": "peers", "threads": "", "status": "peer_mesh.py failed: " + why}]
+    return rows
+
+
+def fmt(x, spec):
+    return "" if x is None else format(x, spec)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--sets", default="corpus,bench1e6", help=f"comma list of {','.join(SETS)}")
+    ap.add_argument("--only", default="", help="comma list of substrings: inputs to run")
+    ap.add_argument("--threads", default="1,2")
+    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--peers", default="gmsh-hxt,tetgen,netgen",
+                    help="peer_mesh.py names, or none")
+    ap.add_argument("--peer-repeat", type=int, default=1)
+    ap.add_argument("--binary", default=os.path.join(ROOT, "target", "release", "parafront"))
+    ap.add_argument("--out", default=os.path.join(ROOT, "BENCHMARKS.md"))
+    a = ap.parse_args()
+    threads = [int(t) for t in a.threads.split(",")]
+    peers = [] if a.peers == "none" else a.peers.split(",")
+    if not os.path.exists(a.binary):
+        subprocess.run(["cargo", "build", "--release", "-p", "parafront"], cwd=ROOT, check=True)
+    work = tempfile.mkdtemp(prefix="pf-bench-")
+    started = datetime.datetime.now().strftime("%Y-%m-%d %H:%M")
+    sections = []
+    for set_name in a.sets.split(","):
+        rows = []
+        stage_rows = []
+        for rel, extra in SETS[set_name]:
+            surf = resolve(rel)
+            if a.only and not any(o in rel for o in a.only.split(",")):
+                continue
+            if not os.path.exists(surf):
+                print(f"skip {rel}: not found", file=sys.stderr)
+                continue
+            name = os.path.basename(surf)
+            mesh = os.path.join(work, name + ".vtu")
+            healed = None
+            if "--heal" in extra:
+                healed = os.path.join(work, name + ".healed.stl")
+                extra = extra + ["--healed-surface", healed]
+            for t in threads:
+                runs = [run_parafront(a.binary, surf, extra, t, mesh) for _ in range(a.repeat)]
+                last = runs[-1]
+                if not last["ok"]:
+                    msg = last["log"].strip().splitlines()[-1] if last["log"].strip() else "failed"
+                    rows.append([name, "parafront", t, "fails: " + msg.replace("|", "/")])
+                    print(f"{name} parafront {t}: {msg}", file=sys.stderr)
+                    continue
+                valid = meshcheck(surf, mesh, healed)
+                peak = peak_rss_bytes(a.binary, surf, extra, t, mesh)
+                wall = median([r["wall"] for r in runs])
+                tets = last.get("tets", 0)
+                rows.append([name, "parafront", t, tets, wall, tets / wall / t if wall else None,
+                             peak / tets if peak and tets else None, last.get("min_dih"),
+                             last.get("pct10"), last.get("rr"),
+                             "yes" if valid else "NO",
+                             f"{last['fill_cavities']} / {last['fill_tets']}"
+                             + (" (region)" if last["region_fill"] else "")])
+                stages = {}
+                for r in runs:
+                    for k, v in r.get("stages", {}).items():
+                        stages.setdefault(k, []).append(v)
+                stage_rows.append((name, t, {k: median(v) for k, v in stages.items()}))
+                print(f"{name} parafront {t}: {tets} tets {wall:.2f} s valid={valid}", file=sys.stderr)
+            # Peers mesh what parafront meshed: the healed surface for dirty/.
+            peer_surf = healed if healed and os.path.exists(healed) else surf
+            for r in run_peers(peer_surf, peers, threads, a.peer_repeat, os.path.join(work, "peers.jsonl")):
+                if r.get("status") != "ok":
+                    rows.append([name, r["peer"], r["threads"], "fails: " + str(r.get("status"))])
+                    continue
+                rows.append([name, r["peer"], r["threads"], r["tets"], r["t_mesh"],
+                             r["tets_per_s_per_thread"], r.get("peak_bytes_per_tet"),
+                             r["min_dihedral"], 100 * r["frac_min_dih_lt10"], r["radius_ratio_mean"],
+                             "kept" if r.get("surface_preserved") else "NOT kept", ""])
+        sections.append((set_name, merge_repeats(rows), stage_rows))
+    write(a, sections, started, threads, peers)
+    print(f"wrote {a.out}", file=sys.stderr)
+
+
+def merge_repeats(rows):
+    """Peer rows repeated over --peer-repeat: medians."""
+    out, groups = [], {}
+    for r in rows:
+        key = tuple(r[:3])
+        if r[1] == "parafront" or isinstance(r[3], str):
+            out.append(r)
+            continue
+        if key not in groups:
+            groups[key] = []
+            out.append(key)
+        groups[key].append(r)
+    merged = []
+    for r in out:
+        if isinstance(r, tuple):
+            g = groups[r]
+            m = list(g[0])
+            m[4] = median([x[4] for x in g])
+            m[5] = median([x[5] for x in g])
+            merged.append(m)
+        else:
+            merged.append(r)
+    return merged
+
+
+def write(a, sections, started, threads, peers):
+    try:
+        rev = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True,
+                             text=True).stdout.strip()
+    except OSError:
+        rev = "?"
+    cpu = platform.processor() or platform.machine()
+    try:
+        with open("/proc/cpuinfo") as f:
+            cpu = next((l.split(":", 1)[1].strip() for l in f if l.startswith("model name")), cpu)
+    except OSError:
+        pass
+    L = []
+    L.append("# Benchmarks\n")
+    L.append("Written by `scripts/bench.py`; do not edit by hand. To reproduce:\n")
+    L.append("```\ncargo build --release -p parafront\npip install numpy meshio gmsh tetgen netgen-mesher\n"
+             f"python3 scripts/bench.py --sets {a.sets} --threads {a.threads} --repeat {a.repeat} "
+             f"--peers {a.peers or 'none'}\n```\n")
+    L.append(f"Sitting: {started}, commit {rev}, {os.cpu_count()} cores ({cpu}).\n")
+    L.append("- **parafront**: the whole `parafront mesh` run as a user times it (default options, "
+             "`--threads` as given; read, size field, front, improvement, check, quality, write), "
+             f"median of {a.repeat}. Peak B/tet: the process's peak RSS over the tets.")
+    L.append("- **Peers** (`../shared/tools/peers/peer_mesh.py --h auto`, each keeping the surface): "
+             "their meshing call, with their own optimisation. Peak B/tet includes the Python process.")
+    L.append("- tets/s/core: tets over seconds over threads. Quality as meshcheck computes it: "
+             "worst min dihedral, share of tets with a dihedral under 10°, mean radius ratio.")
+    L.append("- valid: `meshcheck.py --surface` on parafront's mesh (against the healed surface "
+             "for dirty/ inputs). fill: cavities closed by the constrained fill / its tets "
+             "(region: a region filled whole). Peers mesh the healed surface of dirty/ inputs.\n")
+    for name, rows, stage_rows in sections:
+        L.append(f"## {name}\n")
+        L.append("| input | mesher | threads | tets | s | tets/s/core | peak B/tet | min dih ° | % < 10° "
+                 "| mean rr | valid / surface | fill |")
+        L.append("|---|---|---|---|---|---|---|---|---|---|---|---|")
+        for r in rows:
+            if isinstance(r[3], str):
+                L.append(f"| {r[0]} | {r[1]} | {r[2]} | {r[3]} | | | | | | | | |")
+                continue
+            L.append(f"| {r[0]} | {r[1]} | {r[2]} | {r[3]:,} | {fmt(r[4], '.2f')} | {fmt(r[5], ',.0f')} "
+                     f"| {fmt(r[6], ',.0f')} | {fmt(r[7], '.2f')} | {fmt(r[8], '.1f')} | {fmt(r[9], '.3f')} "
+                     f"| {r[10]} | {r[11]} |")
+        # Ratios to the peers, per input and thread count.
+        L.append("")
+        ratio_lines = []
+        by = {}
+        for r in rows:
+            if not isinstance(r[3], str):
+                by[(r[0], r[1], r[2])] = r
+        for (inp, mesher, t), r in by.items():
+            if mesher != "parafront":
+                continue
+            parts = []
+            for p in peers:
+                q = by.get((inp, p, t)) or by.get((inp, p, 1))
+                if q and q[4] and r[4]:
+                    parts.append(f"{p} {r[4] / q[4]:.1f}x its time")
+            if parts:
+                ratio_lines.append(f"- {inp}, {t} thread(s): parafront takes " + ", ".join(parts))
+        if ratio_lines:
+            L.append("Whole run over the peer's meshing call:\n")
+            L += ratio_lines
+            L.append("")
+        if stage_rows:
+            keys = []
+            for _, _, st in stage_rows:
+                for k in st:
+                    if k not in keys:
+                        keys.append(k)
+            L.append("parafront's stages (seconds, medians):\n")
+            L.append("| input | threads | " + " | ".join(keys) + " |")
+            L.append("|---|---|" + "---|" * len(keys))
+            for inp, t, st in stage_rows:
+                L.append(f"| {inp} | {t} | " + " | ".join(fmt(st.get(k), '.3f') for k in keys) + " |")
+            L.append("")
+    with open(a.out, "w") as f:
+        f.write("\n".join(L) + "\n")
+
+
+if __name__ == "__main__":
+    main()
