@@ -4,6 +4,7 @@
     python3 scripts/bench.py                       # corpus + bench 1e6, writes BENCHMARKS.md
     python3 scripts/bench.py --sets corpus --repeat 1 --out /tmp/b.md
     python3 scripts/bench.py --sets bench1e5 --peers gmsh-hxt --threads 1
+    python3 scripts/bench.py --sets hard --threads 2 --peers gmsh-hxt,tetgen --append
 
 parafront is timed as a user times it: the whole `parafront mesh` process,
 default options, from start to exit (reading, meshing, improvement, checks,
@@ -53,13 +54,25 @@ SETS = {
         ("dirty/idler_riser.STL", ["--heal"]),
         ("@crates/cli/tests/data/needle_frustum.obj", []),
     ],
+    # Issue 20's hard surfaces, written by the CLI's hard_surfaces example.
+    "hard": [(f"%{n}.obj", []) for n in ["needle_1000", "needle_5000", "schonhardt",
+                                          "twisted_square", "rod", "slot_1e-2", "slot_1e-3",
+                                          "boss_1e-4"]]
+    + [("%slot_1e-2.obj", ["--size", "0.1"]), ("%boss_1e-4.obj", ["--size", "0.1"])],
     "bench1e5": [(f"bench/{n}_1e5.stl", []) for n in ["sphere", "torus", "box2holes", "spheres27"]],
     "bench1e6": [(f"bench/{n}_1e6.stl", []) for n in ["sphere", "torus"]],
     "bench5e6": [(f"bench/{n}_5e6.stl", []) for n in ["sphere"]],
 }
 
 
-def resolve(rel):
+def resolve(rel, work):
+    if rel.startswith("%"):
+        hard = os.path.join(work, "hard")
+        if not os.path.isdir(hard):
+            subprocess.run(["cargo", "run", "--release", "-q", "-p", "parafront", "--example",
+                            "hard_surfaces", "--", hard], cwd=ROOT, check=True,
+                           stdout=subprocess.DEVNULL)
+        return os.path.join(hard, rel[1:])
     if rel.startswith("@"):
         return os.path.join(ROOT, rel[1:])
     if rel.startswith("bench/"):
@@ -132,7 +145,7 @@ def meshcheck(surf, mesh, healed):
     return p.returncode == 0
 
 
-def run_peers(surf, peers, threads, repeat, jsonl):
+def run_peers(surf, peers, threads, repeat, jsonl, h="auto"):
     if not peers:
         return []
     script = os.path.join(SHARED, "tools", "peers", "peer_mesh.py")
@@ -140,7 +153,7 @@ def run_peers(surf, peers, threads, repeat, jsonl):
     for _ in range(repeat):
         if os.path.exists(jsonl):
             os.remove(jsonl)
-        cmd = [sys.executable, script, surf, "--peers", ",".join(peers), "--h", "auto",
+        cmd = [sys.executable, script, surf, "--peers", ",".join(peers), "--h", h,
                "--threads", ",".join(map(str, threads)), "--jsonl", jsonl, "--timeout", "600"]
         # In the scratch folder: TetGen leaves files in its working folder.
         p = subprocess.run(cmd, capture_output=True, text=True, cwd=os.path.dirname(jsonl))
@@ -169,6 +182,8 @@ def main():
     ap.add_argument("--peer-repeat", type=int, default=1)
     ap.add_argument("--binary", default=os.path.join(ROOT, "target", "release", "parafront"))
     ap.add_argument("--out", default=os.path.join(ROOT, "BENCHMARKS.md"))
+    ap.add_argument("--append", action="store_true",
+                    help="add the sets' sections (with their own sitting line) to --out")
     a = ap.parse_args()
     threads = [int(t) for t in a.threads.split(",")]
     peers = [] if a.peers == "none" else a.peers.split(",")
@@ -181,7 +196,7 @@ def main():
         rows = []
         stage_rows = []
         for rel, extra in SETS[set_name]:
-            surf = resolve(rel)
+            surf = resolve(rel, work)
             if a.only and not any(o in rel for o in a.only.split(",")):
                 continue
             if not os.path.exists(surf):
@@ -189,6 +204,8 @@ def main():
                 continue
             name = os.path.basename(surf)
             mesh = os.path.join(work, name + ".vtu")
+            if "--size" in extra:
+                name += " --size " + extra[extra.index("--size") + 1]
             healed = None
             if "--heal" in extra:
                 healed = os.path.join(work, name + ".healed.stl")
@@ -219,7 +236,8 @@ def main():
                 print(f"{name} parafront {t}: {tets} tets {wall:.2f} s valid={valid}", file=sys.stderr)
             # Peers mesh what parafront meshed: the healed surface for dirty/.
             peer_surf = healed if healed and os.path.exists(healed) else surf
-            for r in run_peers(peer_surf, peers, threads, a.peer_repeat, os.path.join(work, "peers.jsonl")):
+            h = extra[extra.index("--size") + 1] if "--size" in extra else "auto"
+            for r in run_peers(peer_surf, peers, threads, a.peer_repeat, os.path.join(work, "peers.jsonl"), h):
                 if r.get("status") != "ok":
                     rows.append([name, r["peer"], r["threads"], "fails: " + str(r.get("status"))])
                     continue
@@ -270,22 +288,11 @@ def write(a, sections, started, threads, peers):
     except OSError:
         pass
     L = []
-    L.append("# Benchmarks\n")
-    L.append("Written by `scripts/bench.py`; do not edit by hand. To reproduce:\n")
-    L.append("```\ncargo build --release -p parafront\npip install numpy meshio gmsh tetgen netgen-mesher\n"
-             f"python3 scripts/bench.py --sets {a.sets} --threads {a.threads} --repeat {a.repeat} "
-             f"--peers {a.peers or 'none'}\n```\n")
-    L.append(f"Sitting: {started}, commit {rev}, {os.cpu_count()} cores ({cpu}).\n")
-    L.append("- **parafront**: the whole `parafront mesh` run as a user times it (default options, "
-             "`--threads` as given; read, size field, front, improvement, check, quality, write), "
-             f"median of {a.repeat}. Peak B/tet: the process's peak RSS over the tets.")
-    L.append("- **Peers** (`../shared/tools/peers/peer_mesh.py --h auto`, each keeping the surface): "
-             "their meshing call, with their own optimisation. Peak B/tet includes the Python process.")
-    L.append("- tets/s/core: tets over seconds over threads. Quality as meshcheck computes it: "
-             "worst min dihedral, share of tets with a dihedral under 10°, mean radius ratio.")
-    L.append("- valid: `meshcheck.py --surface` on parafront's mesh (against the healed surface "
-             "for dirty/ inputs). fill: cavities closed by the constrained fill / its tets "
-             "(region: a region filled whole). Peers mesh the healed surface of dirty/ inputs.\n")
+    if a.append:
+        L.append(f"## Sitting {started} (commit {rev}): `scripts/bench.py --sets {a.sets} "
+                 f"--threads {a.threads} --repeat {a.repeat} --peers {a.peers or 'none'}`\n")
+    else:
+        header(L, a, started, rev, cpu)
     for name, rows, stage_rows in sections:
         L.append(f"## {name}\n")
         L.append("| input | mesher | threads | tets | s | tets/s/core | peak B/tet | min dih ° | % < 10° "
@@ -331,8 +338,28 @@ def write(a, sections, started, threads, peers):
             for inp, t, st in stage_rows:
                 L.append(f"| {inp} | {t} | " + " | ".join(fmt(st.get(k), '.3f') for k in keys) + " |")
             L.append("")
-    with open(a.out, "w") as f:
-        f.write("\n".join(L) + "\n")
+    with open(a.out, "a" if a.append else "w") as f:
+        f.write(("\n" if a.append else "") + "\n".join(L) + "\n")
+
+
+def header(L, a, started, rev, cpu):
+    L.append("# Benchmarks\n")
+    L.append("Written by `scripts/bench.py`; do not edit by hand. To reproduce:\n")
+    L.append("```\ncargo build --release -p parafront\npip install numpy meshio gmsh tetgen netgen-mesher\n"
+             f"python3 scripts/bench.py --sets {a.sets} --threads {a.threads} --repeat {a.repeat} "
+             f"--peers {a.peers or 'none'}\n```\n")
+    L.append(f"Sitting: {started}, commit {rev}, {os.cpu_count()} cores ({cpu}).\n")
+    L.append("- **parafront**: the whole `parafront mesh` run as a user times it (default options, "
+             "`--threads` as given; read, size field, front, improvement, check, quality, write), "
+             f"median of {a.repeat}. Peak B/tet: the process's peak RSS over the tets.")
+    L.append("- **Peers** (`../shared/tools/peers/peer_mesh.py --h auto`, each keeping the surface): "
+             "their meshing call, with their own optimisation. Peak B/tet includes the Python process.")
+    L.append("- tets/s/core: tets over seconds over threads. Quality as meshcheck computes it: "
+             "worst min dihedral, share of tets with a dihedral under 10°, mean radius ratio.")
+    L.append("- valid: `meshcheck.py --surface` on parafront's mesh (against the healed surface "
+             "for dirty/ inputs). fill: cavities closed by the constrained fill / its tets "
+             "(region: a region filled whole). Peers mesh the healed surface of dirty/ inputs, "
+             "and take `--h` from an input's `--size` where it has one.\n")
 
 
 if __name__ == "__main__":

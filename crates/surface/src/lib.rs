@@ -9,6 +9,7 @@
 #![forbid(unsafe_code)]
 
 pub mod generate;
+pub mod hard;
 pub mod heal;
 pub mod read;
 pub mod validate;
