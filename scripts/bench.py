@@ -8,12 +8,13 @@
 
 parafront is timed as a user times it: the whole `parafront mesh` process,
 default options, from start to exit (reading, meshing, improvement, checks,
-writing). Its peak memory is the process's peak RSS. The peers are run by
-../shared/tools/peers/peer_mesh.py (`--h auto`: the mean surface edge, every
-peer keeping the surface), timed over their meshing call with their own
-optimisation. Every parafront mesh is checked by ../shared/tools/meshcheck.py
-against its surface. Times are medians over --repeat runs; compare ratios
-within one file, not across sittings.
+writing). Its peak memory is the peak RSS it reports (VmHWM), median over
+the runs. The peers are run by ../shared/tools/peers/peer_mesh.py (`--h
+auto`: the mean surface edge, every peer keeping the surface), timed over
+their meshing call with their own optimisation. Every parafront mesh is
+checked by ../shared/tools/meshcheck.py against its surface. Times are
+medians over --repeat runs; compare ratios within one file, not across
+sittings.
 
 Needs: python3 with numpy and meshio (meshcheck), and the peers (pip install
 gmsh tetgen netgen-mesher) unless --peers none. The release binary is built
@@ -106,6 +107,8 @@ def parse_summary(out):
     m = re.search(r"^constrained fill: (\d+) cavit\w+ .*?, (\d+) tets", out, re.M)
     r["fill_cavities"] = int(m.group(1)) if m else 0
     r["fill_tets"] = int(m.group(2)) if m else 0
+    m = re.search(r"^peak memory: [\d.]+ MiB \((\d+) bytes/tet\)", out, re.M)
+    r["peak_per_tet"] = int(m.group(1)) if m else None
     m = re.search(r"^recovery: (\d+) rounds", out, re.M)
     r["recovery_rounds"] = int(m.group(1)) if m else 0
     r["region_fill"] = "filled whole" in out
@@ -113,29 +116,18 @@ def parse_summary(out):
 
 
 def run_parafront(binary, surf, extra, threads, out_mesh):
+    """One timed run. Its peak memory is the one the summary reports (the
+    process's VmHWM): wait4's ru_maxrss would count the Python process the
+    child was forked from."""
     cmd = [binary, "mesh", surf, "-o", out_mesh, "--threads", str(threads)] + extra
     t0 = time.perf_counter()
-    p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-    out, _ = p.communicate()
+    p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     wall = time.perf_counter() - t0
-    r = parse_summary(out)
+    r = parse_summary(p.stdout)
     r["ok"] = p.returncode == 0
     r["wall"] = wall
-    r["log"] = out
+    r["log"] = p.stdout
     return r
-
-
-def peak_rss_bytes(binary, surf, extra, threads, out_mesh):
-    """Peak RSS of one run (a separate run: wait4 needs its own child)."""
-    cmd = [binary, "mesh", surf, "-o", out_mesh, "--threads", str(threads)] + extra
-    pid = os.fork()
-    if pid == 0:
-        devnull = os.open(os.devnull, os.O_WRONLY)
-        os.dup2(devnull, 1)
-        os.dup2(devnull, 2)
-        os.execv(binary, cmd)
-    _, status, ru = os.wait4(pid, 0)
-    return ru.ru_maxrss * 1024 if os.WEXITSTATUS(status) == 0 else None
 
 
 def meshcheck(surf, mesh, healed):
@@ -196,9 +188,9 @@ def main():
         rows = []
         stage_rows = []
         for rel, extra in SETS[set_name]:
-            surf = resolve(rel, work)
             if a.only and not any(o in rel for o in a.only.split(",")):
                 continue
+            surf = resolve(rel, work)
             if not os.path.exists(surf):
                 print(f"skip {rel}: not found", file=sys.stderr)
                 continue
@@ -219,11 +211,10 @@ def main():
                     print(f"{name} parafront {t}: {msg}", file=sys.stderr)
                     continue
                 valid = meshcheck(surf, mesh, healed)
-                peak = peak_rss_bytes(a.binary, surf, extra, t, mesh)
                 wall = median([r["wall"] for r in runs])
                 tets = last.get("tets", 0)
                 rows.append([name, "parafront", t, tets, wall, tets / wall / t if wall else None,
-                             peak / tets if peak and tets else None, last.get("min_dih"),
+                             median([r["peak_per_tet"] for r in runs]), last.get("min_dih"),
                              last.get("pct10"), last.get("rr"),
                              "yes" if valid else "NO",
                              f"{last['fill_cavities']} / {last['fill_tets']}"
@@ -251,27 +242,19 @@ def main():
 
 
 def merge_repeats(rows):
-    """Peer rows repeated over --peer-repeat: medians."""
-    out, groups = [], {}
-    for r in rows:
-        key = tuple(r[:3])
-        if r[1] == "parafront" or isinstance(r[3], str):
-            out.append(r)
-            continue
-        if key not in groups:
-            groups[key] = []
-            out.append(key)
-        groups[key].append(r)
+    """Peer rows repeated over --peer-repeat: one row each, medians of time and rate."""
+    groups = {}
+    for i, r in enumerate(rows):
+        # Only the peers' measured rows repeat; the rest stay as they are.
+        key = tuple(r[:3]) if r[1] != "parafront" and not isinstance(r[3], str) else i
+        groups.setdefault(key, []).append(r)
     merged = []
-    for r in out:
-        if isinstance(r, tuple):
-            g = groups[r]
-            m = list(g[0])
+    for g in groups.values():
+        m = list(g[0])
+        if len(g) > 1:
             m[4] = median([x[4] for x in g])
             m[5] = median([x[5] for x in g])
-            merged.append(m)
-        else:
-            merged.append(r)
+        merged.append(m)
     return merged
 
 
@@ -351,7 +334,8 @@ def header(L, a, started, rev, cpu):
     L.append(f"Sitting: {started}, commit {rev}, {os.cpu_count()} cores ({cpu}).\n")
     L.append("- **parafront**: the whole `parafront mesh` run as a user times it (default options, "
              "`--threads` as given; read, size field, front, improvement, check, quality, write), "
-             f"median of {a.repeat}. Peak B/tet: the process's peak RSS over the tets.")
+             f"median of {a.repeat}. Peak B/tet: the process's peak RSS (VmHWM, as its summary "
+             "prints it) over the tets.")
     L.append("- **Peers** (`../shared/tools/peers/peer_mesh.py --h auto`, each keeping the surface): "
              "their meshing call, with their own optimisation. Peak B/tet includes the Python process.")
     L.append("- tets/s/core: tets over seconds over threads. Quality as meshcheck computes it: "

@@ -235,66 +235,11 @@ fn fills_schonhardt_with_a_steiner_point() {
     assert!(!f.steiner.is_empty(), "Schönhardt needs a Steiner point");
 }
 
-/// A box with a slot cut into its top (not star-shaped), faces inward.
+/// A box with a slot cut into its top (not star-shaped), faces inward:
+/// `parafront_surface::hard::slotted_box` turned inside out.
 fn slotted_box(gap: f64) -> (Vec<P3>, Vec<[u32; 3]>) {
-    // Profile in x-z (a U), extruded along y from 0 to 1.
-    let prof: Vec<[f64; 2]> = vec![
-        [0.0, 0.0],
-        [1.0, 0.0],
-        [1.0, 1.0],
-        [0.5 + gap / 2.0, 1.0],
-        [0.5 + gap / 2.0, 0.1],
-        [0.5 - gap / 2.0, 0.1],
-        [0.5 - gap / 2.0, 1.0],
-        [0.0, 1.0],
-    ];
-    let n = prof.len() as u32;
-    let mut pts: Vec<P3> = Vec::new();
-    for y in [0.0, 1.0] {
-        for p in &prof {
-            pts.push([p[0], y, p[1]]);
-        }
-    }
-    // The U's caps as triangles (ear pieces, counter-clockwise in x-z seen
-    // from -y): a fixed triangulation of this octagon.
-    let cap: Vec<[u32; 3]> = vec![
-        [0, 1, 4],
-        [0, 4, 5],
-        [1, 2, 3],
-        [1, 3, 4],
-        [0, 5, 6],
-        [0, 6, 7],
-    ];
-    let mut out: Vec<[u32; 3]> = Vec::new();
-    for c in &cap {
-        // y = 0 cap, outward normal -y.
-        out.push([c[0], c[1], c[2]]);
-        out.push([c[0] + n, c[2] + n, c[1] + n]);
-    }
-    for k in 0..n {
-        let (a, b) = (k, (k + 1) % n);
-        out.push([a, a + n, b + n]);
-        out.push([a, b + n, b]);
-    }
-    // Orient by the sign of the volume.
-    let o = pts[0];
-    let v: f64 = out
-        .iter()
-        .map(|f| {
-            orient3d(
-                pts[f[0] as usize],
-                pts[f[1] as usize],
-                pts[f[2] as usize],
-                o,
-            )
-        })
-        .sum();
-    let inward = if v > 0.0 {
-        out
-    } else {
-        out.iter().map(|f| [f[0], f[2], f[1]]).collect()
-    };
-    (pts, inward)
+    let s = parafront_surface::hard::slotted_box(gap).flipped();
+    (s.points, s.tris)
 }
 
 #[test]

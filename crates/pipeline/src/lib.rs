@@ -416,12 +416,12 @@ fn serial_region(
             ..FrontOptions::default()
         },
     );
+    let region = rf.region_id as usize;
     let res = match res {
         Ok(r) => r,
         // The front could not close the region: the constrained fill of its
         // whole surface (valid, coarse), unless a debug dump was asked for.
         Err(e @ FrontError::Stuck { .. }) if !opts.debug_partial => {
-            let region = rf.region_id as usize;
             // The front took the points; this path is rare, so they are
             // gathered again rather than copied on every run.
             let (points, _) = region_points(s, sizing, rf);
@@ -443,12 +443,7 @@ fn serial_region(
             sum.fill_tets += fill.tets.len();
             return Ok(());
         }
-        Err(e) => {
-            return Err(MeshError::Front {
-                region: rf.region_id as usize,
-                source: e,
-            })
-        }
+        Err(e) => return Err(MeshError::Front { region, source: e }),
     };
     append_region(mesh, rf, &res.points, &res.tets);
     sum.recovery_rounds += res.stats.recovery_rounds;
