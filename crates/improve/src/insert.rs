@@ -48,14 +48,13 @@ pub(crate) struct InsScratch {
 }
 
 /// How good a star is: tets under [`SMALL_DIHEDRAL`], summed shortfall below
-/// 12° (what the search minimises after the count), min dihedral and min
-/// mean ratio.
+/// 12° (what the search minimises after the count) and min dihedral (the
+/// kept star's mean ratio is taken once, at the end).
 #[derive(Clone, Copy, Debug)]
 struct Score {
     under: usize,
     short: f64,
     dmin: f64,
-    qmin: f64,
 }
 
 impl Score {
@@ -64,15 +63,13 @@ impl Score {
         under: 0,
         short: 0.0,
         dmin: f64::INFINITY,
-        qmin: f64::INFINITY,
     };
 
-    /// Adds a tet of min dihedral `d` and mean ratio `q`.
-    fn add(&mut self, d: f64, q: f64) {
+    /// Adds a tet of min dihedral `d`.
+    fn add_angle(&mut self, d: f64) {
         self.under += usize::from(d < SMALL_DIHEDRAL);
         self.short += (12.0 - d).max(0.0);
         self.dmin = self.dmin.min(d);
-        self.qmin = self.qmin.min(q);
     }
 
     /// What the search minimises: the count under [`SMALL_DIHEDRAL`] then the
@@ -90,8 +87,22 @@ impl Score {
     }
 }
 
-fn less(a: (f64, isize, f64), b: (f64, isize, f64)) -> bool {
+type Key = (f64, isize, f64);
+
+fn less(a: Key, b: Key) -> bool {
     a.0 < b.0 - 1e-12 || (a.0 <= b.0 && (a.1 < b.1 || (a.1 == b.1 && a.2 < b.2 - 1e-9)))
+}
+
+/// Whether no star whose first tets give the key `part` can be [`less`]
+/// than `b`: each tet added keeps every part of a key or raises it.
+fn cannot_beat(part: Key, b: Key) -> bool {
+    if part.0 > b.0 {
+        return true;
+    }
+    if part.0 < b.0 - 1e-12 {
+        return false;
+    }
+    part.1 > b.1 || (part.1 == b.1 && part.2 >= b.2 - 1e-9)
 }
 
 impl Work<'_> {
@@ -132,7 +143,17 @@ impl Work<'_> {
         })
     }
 
-    fn score_star(&self, star: &[([PointId; 4], usize)], pos: P3) -> Option<Score> {
+    /// The star's angle score with the new point at `pos` (relative to the
+    /// cavity's `old` one, under `lift`); `None` when a tet is not positive
+    /// or once the star cannot be [`less`] than `bound`.
+    fn score_star(
+        &self,
+        star: &[([PointId; 4], usize)],
+        pos: P3,
+        old: &Score,
+        lift: Option<f64>,
+        bound: Option<Key>,
+    ) -> Option<Score> {
         let mut sc = Score::NONE;
         for &(v, f) in star {
             let mut x = self.pts(v);
@@ -140,9 +161,23 @@ impl Work<'_> {
             if !positive(x) {
                 return None;
             }
-            sc.add(min_dihedral_deg(x), quality(x));
+            sc.add_angle(min_dihedral_deg(x));
+            if bound.is_some_and(|b| cannot_beat(sc.key(old, lift), b)) {
+                return None;
+            }
         }
         Some(sc)
+    }
+
+    /// The star's worst mean ratio with the new point at `pos`.
+    fn star_qmin(&self, star: &[([PointId; 4], usize)], pos: P3) -> f64 {
+        star.iter()
+            .map(|&(v, f)| {
+                let mut x = self.pts(v);
+                x[f] = pos;
+                quality(x)
+            })
+            .fold(f64::INFINITY, f64::min)
     }
 
     /// Cavity `k` of tet `t` into `s.cav`: 0-3 the tet and its neighbour
@@ -189,10 +224,7 @@ impl Work<'_> {
     fn score_old(&self, cav: &[u32]) -> Score {
         let mut sc = Score::NONE;
         for &t in cav {
-            sc.add(
-                min_dihedral_deg(self.pts(self.m.tets[t as usize])),
-                self.q[t as usize],
-            );
+            sc.add_angle(min_dihedral_deg(self.pts(self.m.tets[t as usize])));
         }
         sc
     }
@@ -251,11 +283,9 @@ impl Work<'_> {
             }
             let old = self.score_old(&s.cav);
             for &p in &cands {
-                if let Some(sc) = self.score_star(&s.star, p) {
-                    if best
-                        .as_ref()
-                        .is_none_or(|b| less(sc.key(&old, lift), b.0.key(&b.1, lift)))
-                    {
+                let bound = best.as_ref().map(|b| b.0.key(&b.1, lift));
+                if let Some(sc) = self.score_star(&s.star, p, &old, lift, bound) {
+                    if bound.is_none_or(|b| less(sc.key(&old, lift), b)) {
                         best = Some((sc, old, p));
                         s.best_star.clear();
                         s.best_star.extend_from_slice(&s.star);
@@ -289,7 +319,10 @@ impl Work<'_> {
             0.3 * len,
             stop * len,
             iters,
-            |p, _| self.score_star(&s.best_star, p),
+            |p, cur| {
+                let bound = Some(cur.key(&old, lift));
+                self.score_star(&s.best_star, p, &old, lift, bound)
+            },
             |n, cur| less(n.key(&old, lift), cur.key(&old, lift)),
         );
         let ok = (sc.under < old.under && sc.dmin >= old.dmin)
@@ -308,7 +341,7 @@ impl Work<'_> {
                 v
             }),
         );
-        c.qmin = sc.qmin;
+        c.qmin = self.star_qmin(&s.best_star, pos);
         Ok(pos)
     }
 
@@ -518,5 +551,48 @@ impl Work<'_> {
             found = Outcome::Done;
         }
         found
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The search's pruning is sound: a star whose first tets cannot beat
+    /// a key never does, whatever tets follow.
+    #[test]
+    fn a_pruned_star_never_beats_the_bound() {
+        let mut x = 0x1234_5678_9abc_def1u64;
+        let mut r = || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            (x >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut pruned = 0;
+        for k in 0..20_000 {
+            let lift = (k % 2 == 0).then_some(LIFT_GOAL);
+            let mut old = Score::NONE;
+            for _ in 0..3 {
+                old.add_angle(15.0 * r());
+            }
+            let mut b = Score::NONE;
+            for _ in 0..6 {
+                // Angles near the thresholds, so that keys tie often.
+                b.add_angle([0.05, 0.2, 9.99, 10.0, 12.0, 20.0][(r() * 6.0) as usize]);
+            }
+            let bound = b.key(&old, lift);
+            let mut sc = Score::NONE;
+            let mut was_pruned = false;
+            for _ in 0..6 {
+                sc.add_angle([0.05, 0.2, 9.99, 10.0, 12.0, 20.0][(r() * 6.0) as usize]);
+                was_pruned |= cannot_beat(sc.key(&old, lift), bound);
+                if was_pruned {
+                    assert!(!less(sc.key(&old, lift), bound));
+                }
+            }
+            pruned += usize::from(was_pruned);
+        }
+        assert!(pruned > 1000, "{pruned}");
     }
 }

@@ -6,9 +6,9 @@
 //! mesh and keeps it only when the worst quality of the tets it makes
 //! beats the worst of those it replaces, and every new tet is positive
 //! under the exact predicate and in floating point.
-use crate::quality::{min_dihedral_deg, quality};
+use crate::quality::{min_dihedral_deg, positive_quality, quality};
 use crate::work::{ring_tets, Work, MAX_RING};
-use parafront_geom::{cross, dist2, norm, orient3d, sub, tet_volume6, P3};
+use parafront_geom::{cross, dist2, norm, sub, P3};
 use parafront_mesh::{PointId, TET_FACES};
 
 /// What a local operation did.
@@ -60,7 +60,17 @@ pub(crate) fn beats(new: f64, old: f64) -> bool {
 
 #[inline]
 pub(crate) fn positive(p: [P3; 4]) -> bool {
-    tet_volume6(p[0], p[1], p[2], p[3]) > 0.0 && orient3d(p[0], p[1], p[2], p[3]) > 0.0
+    crate::quality::positive_volume6(p).is_some()
+}
+
+/// A ball's quality with one point moved.
+pub(crate) enum BallQ {
+    /// A tet would not be positive.
+    Inverted,
+    /// A tet would be under the floor asked for.
+    Below,
+    /// Worst and mean quality.
+    Ok(f64, f64),
 }
 
 /// The compass search's directions: the axes and the cube's diagonals.
@@ -353,9 +363,10 @@ impl Work<'_> {
         Outcome::Done
     }
 
-    /// Worst and mean quality of `ball` with `p` at `pos`; `None` when a
-    /// tet would not be positive (exactly and in floating point).
-    pub(crate) fn ball_quality_at(&self, p: PointId, pos: P3, ball: &[u32]) -> Option<(f64, f64)> {
+    /// Worst and mean quality of `ball` with `p` at `pos`, stopping at the
+    /// first tet that would not be positive (exactly and in floating
+    /// point) or would be under `floor` (a move no caller keeps).
+    pub(crate) fn ball_quality_above(&self, p: PointId, pos: P3, ball: &[u32], floor: f64) -> BallQ {
         let mut qmin = f64::INFINITY;
         let mut sum = 0.0;
         for &t in ball {
@@ -366,14 +377,16 @@ impl Work<'_> {
                     x[k] = pos;
                 }
             }
-            if !positive(x) {
-                return None;
+            let Some(q) = positive_quality(x) else {
+                return BallQ::Inverted;
+            };
+            if q < floor {
+                return BallQ::Below;
             }
-            let q = quality(x);
             qmin = qmin.min(q);
             sum += q;
         }
-        Some((qmin, sum / ball.len() as f64))
+        BallQ::Ok(qmin, sum / ball.len() as f64)
     }
 
     /// Moves `p` to `pos` and refreshes the qualities of its ball.
@@ -465,9 +478,10 @@ impl Work<'_> {
             (lap, 0.25),
         ] {
             let pos = [0, 1, 2].map(|k| p0[k] + w * (c[k] - p0[k]));
-            match self.ball_quality_at(p, pos, ball) {
-                None => inverted = true,
-                Some((m, mean)) => {
+            match self.ball_quality_above(p, pos, ball, qmin) {
+                BallQ::Inverted => inverted = true,
+                BallQ::Below => {}
+                BallQ::Ok(m, mean) => {
                     if beats(m, qmin) || (m >= qmin && mean > qmean + 1e-9) {
                         self.commit_move(p, pos, ball);
                         return Outcome::Done;
@@ -494,13 +508,13 @@ impl Work<'_> {
             .iter()
             .map(|&t| self.q[t as usize])
             .fold(f64::INFINITY, f64::min);
-        let out = match self.ball_quality_at(p, pos, &ball) {
-            None => Outcome::Inverted,
-            Some((m, _)) if m >= qmin => {
+        let out = match self.ball_quality_above(p, pos, &ball, qmin) {
+            BallQ::Inverted => Outcome::Inverted,
+            BallQ::Below => Outcome::NotBetter,
+            BallQ::Ok(..) => {
                 self.commit_move(p, pos, &ball);
                 Outcome::Done
             }
-            Some(_) => Outcome::NotBetter,
         };
         s.ball = ball;
         out
@@ -528,8 +542,9 @@ impl Work<'_> {
             let d = parafront_geom::sub(self.m.points[x.idx()], p0);
             for f in [0.25, 0.1, 0.03, -0.03, -0.1, -0.25] {
                 let pos = [0, 1, 2].map(|k| p0[k] + f * d[k]);
-                if let Some((m, mean)) = self.ball_quality_at(p, pos, &ball) {
-                    if beats(m, best.map_or(qmin, |b| b.0))
+                let floor = best.map_or(qmin, |b| b.0);
+                if let BallQ::Ok(m, mean) = self.ball_quality_above(p, pos, &ball, floor) {
+                    if beats(m, floor)
                         && mean >= mean0 - SELECTIVE_TRADE * (m - qmin)
                     {
                         best = Some((m, pos));
@@ -581,7 +596,7 @@ impl Work<'_> {
                         x[k] = pos;
                     }
                 }
-                if !positive(x) || quality(x) < floor {
+                if positive_quality(x).is_none_or(|q| q < floor) {
                     return None;
                 }
                 let dt = min_dihedral_deg(x);

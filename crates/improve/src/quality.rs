@@ -22,6 +22,47 @@ pub fn quality(p: [P3; 4]) -> f64 {
     }
 }
 
+/// `6V` of a tet that is positive both in floating point and exactly,
+/// else `None`. The exact predicate runs only where the float
+/// determinant is within its error bound of zero (Shewchuk's first-stage
+/// bound for this expansion, from the permanent).
+#[inline]
+pub fn positive_volume6(p: [P3; 4]) -> Option<f64> {
+    use parafront_geom::{cross, dot, orient3d, sub};
+    let u = sub(p[1], p[0]);
+    let w = sub(p[2], p[0]);
+    let z = sub(p[3], p[0]);
+    // `tet_volume6`, operation for operation.
+    let v6 = dot(cross(u, w), z);
+    if !(v6 > 0.0) {
+        return None;
+    }
+    let perm = z[0].abs() * ((u[1] * w[2]).abs() + (u[2] * w[1]).abs())
+        + z[1].abs() * ((u[2] * w[0]).abs() + (u[0] * w[2]).abs())
+        + z[2].abs() * ((u[0] * w[1]).abs() + (u[1] * w[0]).abs());
+    const BOUND: f64 = 8.0 * f64::EPSILON * 0.5;
+    (v6 > BOUND * perm || orient3d(p[0], p[1], p[2], p[3]) > 0.0).then_some(v6)
+}
+
+/// The mean ratio of a tet that is positive both in floating point and
+/// exactly, else `None`: [`quality`] with the one determinant.
+#[inline]
+pub fn positive_quality(p: [P3; 4]) -> Option<f64> {
+    let v6 = positive_volume6(p)?;
+    let l2 = dist2(p[0], p[1])
+        + dist2(p[0], p[2])
+        + dist2(p[0], p[3])
+        + dist2(p[1], p[2])
+        + dist2(p[1], p[3])
+        + dist2(p[2], p[3]);
+    if l2 > 0.0 {
+        let v3 = 0.5 * v6;
+        Some(12.0 * (v3 * v3).cbrt() / l2)
+    } else {
+        Some(0.0)
+    }
+}
+
 /// Each edge of a tet (its first two corners) with the two other corners.
 const EDGE_SIDES: [[usize; 4]; 6] = [
     [0, 1, 2, 3],
@@ -158,5 +199,41 @@ mod tests {
         }
         let flat = [[0.0; 3], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
         assert_eq!(min_dihedral_deg(flat), min_dihedral_slow(flat));
+    }
+
+    #[test]
+    fn positive_quality_is_the_exact_test_then_the_mean_ratio() {
+        use parafront_geom::orient3d;
+        let mut x = 0x2545_f491_4f6c_dd1du64;
+        let mut r = || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            (x >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        let (mut near, mut neg) = (0, 0);
+        for k in 0..20_000 {
+            let mut p = [[0.0; 3]; 4];
+            for q in &mut p {
+                *q = [r(), r(), r()];
+            }
+            // Near-flat: the fourth point a rounding away from the plane
+            // of the first three, where the float sign can be wrong.
+            if k % 2 == 0 {
+                let (s, t) = (r() + 0.5, r() + 0.5);
+                for d in 0..3 {
+                    p[3][d] = p[0][d] + s * (p[1][d] - p[0][d]) + t * (p[2][d] - p[0][d]);
+                }
+                p[3][k % 3] += r() * 1e-15;
+            }
+            let exact = orient3d(p[0], p[1], p[2], p[3]) > 0.0;
+            let want = (tet_volume6(p[0], p[1], p[2], p[3]) > 0.0 && exact).then(|| quality(p));
+            let got = positive_quality(p);
+            assert_eq!(got.map(f64::to_bits), want.map(f64::to_bits), "{p:?}");
+            near += usize::from(k % 2 == 0 && got.is_some());
+            neg += usize::from(got.is_none());
+        }
+        // Both branches and both answers were exercised.
+        assert!(near > 1000 && neg > 5000, "{near} {neg}");
     }
 }
