@@ -179,6 +179,12 @@ struct MeshArgs {
     /// front would give up.
     #[arg(long, value_name = "ROUNDS", default_value_t = parafront_front::DEFAULT_FILL_AFTER)]
     fill_after: u32,
+    /// Optimal space-filling tets (§2): the serial front leaves the
+    /// interior, where the size field is nearly uniform, to a BCC lattice
+    /// of near-ideal tets and meshes only around it. auto: when the size
+    /// field has a largest size (--size or --hmax); on; off
+    #[arg(long, value_name = "MODE", default_value = "auto")]
+    lattice: parafront_pipeline::LatticeMode,
     /// With --parts > 1: a region less deep than this many mean surface
     /// edges (volume over area) is meshed by the serial front instead (0:
     /// never).
@@ -345,6 +351,7 @@ fn mesh_options(a: &MeshArgs) -> Result<MeshOptions, Fail> {
         o.optimize_parts = n;
     }
     o.fill_after = a.fill_after;
+    o.lattice = a.lattice;
     o.thin_depth = a.thin_depth;
     o.serial_from = a.serial_from;
     o.ddg_cap = a.ddg_cap;
@@ -552,6 +559,14 @@ fn print_summary(sum: &Summary) {
     }
     for (r, e) in &sum.serial_fallback {
         println!("region {r}: meshed by the serial front, the parallel passes gave way: {e}");
+    }
+    if sum.lattice_tets > 0 {
+        println!(
+            "lattice: {} tets in {} cubes, {:.1}% of the tets",
+            sum.lattice_tets,
+            sum.lattice_cells,
+            100.0 * sum.lattice_tets as f64 / sum.tets.max(1) as f64
+        );
     }
     if sum.recovery_rounds > 0 {
         println!(

@@ -366,7 +366,13 @@ impl Work<'_> {
     /// Worst and mean quality of `ball` with `p` at `pos`, stopping at the
     /// first tet that would not be positive (exactly and in floating
     /// point) or would be under `floor` (a move no caller keeps).
-    pub(crate) fn ball_quality_above(&self, p: PointId, pos: P3, ball: &[u32], floor: f64) -> BallQ {
+    pub(crate) fn ball_quality_above(
+        &self,
+        p: PointId,
+        pos: P3,
+        ball: &[u32],
+        floor: f64,
+    ) -> BallQ {
         let mut qmin = f64::INFINITY;
         let mut sum = 0.0;
         for &t in ball {
@@ -544,9 +550,7 @@ impl Work<'_> {
                 let pos = [0, 1, 2].map(|k| p0[k] + f * d[k]);
                 let floor = best.map_or(qmin, |b| b.0);
                 if let BallQ::Ok(m, mean) = self.ball_quality_above(p, pos, &ball, floor) {
-                    if beats(m, floor)
-                        && mean >= mean0 - SELECTIVE_TRADE * (m - qmin)
-                    {
+                    if beats(m, floor) && mean >= mean0 - SELECTIVE_TRADE * (m - qmin) {
                         best = Some((m, pos));
                     }
                 }

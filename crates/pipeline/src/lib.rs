@@ -11,6 +11,7 @@ pub use regions::{material_regions, RegionFront};
 
 use parafront_ddg::DdgError;
 use parafront_front::{advance, FrontError, FrontInput, FrontOptions, SizeMode};
+use parafront_lattice::{Lattice, LatticeOptions};
 use parafront_mesh::{CheckError, PointId, QualityReport, TetMesh};
 use parafront_passes::{mesh_parallel, ParOptions, ParOutput, ParStats, PassError, Piece};
 pub use parafront_passes::{process_cpu_seconds, DDG_CAP, SERIAL_FROM, THIN_DEPTH};
@@ -80,6 +81,11 @@ pub struct MeshOptions {
     /// where the front would give up.
     #[serde(default = "default_fill_after")]
     pub fill_after: u32,
+    /// Optimal space-filling tets (§2, `parafront_lattice`): a BCC lattice
+    /// fills the interior where the size field is nearly uniform, and the
+    /// front meshes only around it. The serial front only (one part).
+    #[serde(default)]
+    pub lattice: LatticeMode,
     /// Parallel mesher: depth in mean surface edges (volume over area)
     /// under which a region is meshed by the serial front instead (0:
     /// never). See `parafront_passes::ParOptions::thin_depth`.
@@ -132,6 +138,7 @@ impl Default for MeshOptions {
             optimize_parts: 0,
             regions: false,
             fill_after: default_fill_after(),
+            lattice: LatticeMode::default(),
             thin_depth: default_thin_depth(),
             serial_from: default_serial_from(),
             ddg_cap: default_ddg_cap(),
@@ -141,6 +148,33 @@ impl Default for MeshOptions {
 
 fn one() -> usize {
     1
+}
+
+/// When the serial front leaves the interior to the lattice (§2).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum LatticeMode {
+    /// When the size field has a largest size (`--size` or `--hmax`): the
+    /// interior is then uniform. Under the default gradation alone the
+    /// size doubles every few elements, each lattice level is a thin
+    /// shell, and the lattice costs more than it saves (sphere_1e5: 3 % of
+    /// the tets for 0.09 s).
+    #[default]
+    Auto,
+    On,
+    Off,
+}
+
+impl std::str::FromStr for LatticeMode {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "auto" => Ok(LatticeMode::Auto),
+            "on" => Ok(LatticeMode::On),
+            "off" => Ok(LatticeMode::Off),
+            _ => Err(format!("unknown lattice mode {s:?} (auto, on or off)")),
+        }
+    }
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -175,6 +209,9 @@ pub struct Summary {
     /// and the tets the fill made (issue 20).
     pub cavities_filled: usize,
     pub fill_tets: usize,
+    /// Tets and cubes of the optimal space-filling lattice (§2).
+    pub lattice_tets: usize,
+    pub lattice_cells: usize,
     /// Regions the front could not close at all, filled whole by the
     /// constrained fill of their surface instead: valid, but coarse (their
     /// tets follow the surface, not the size field). Ids as in `Front`
@@ -275,6 +312,7 @@ fn mesh_surface_here(s: &Surface, opts: &MeshOptions) -> Result<(TetMesh, Summar
 
     let t0 = Instant::now();
     let mut mesh = surface_mesh(s);
+    let mut lattice_inner: Vec<u32> = Vec::new();
     if opts.parts > 1 {
         mesh_parts(
             s,
@@ -286,15 +324,30 @@ fn mesh_surface_here(s: &Surface, opts: &MeshOptions) -> Result<(TetMesh, Summar
             mesh_parallel,
         )?;
     } else {
-        mesh_serial(s, &fronts, &sizing, opts, &mut mesh, &mut sum)?;
+        mesh_serial(
+            s,
+            &fronts,
+            &sizing,
+            opts,
+            &mut mesh,
+            &mut sum,
+            &mut lattice_inner,
+        )?;
         sum.stages.push(("front", t0.elapsed().as_secs_f64()));
     }
 
     if opts.optimize > 0 {
         sum.quality_before = Some(QualityReport::new(&mesh));
         let t0 = Instant::now();
-        // The surface points (ids below s.points.len()) never move (§9.3).
-        let frozen = vec![true; s.points.len()];
+        // The surface points (ids below s.points.len()) never move (§9.3),
+        // nor do the lattice's inner points: their tets are already ideal.
+        let mut frozen = vec![true; s.points.len()];
+        if !lattice_inner.is_empty() {
+            frozen.resize(mesh.points.len(), false);
+            for &p in &lattice_inner {
+                frozen[p as usize] = true;
+            }
+        }
         let io = parafront_improve::ImproveOptions {
             level: opts.optimize,
             parts: opts.optimize_parts,
@@ -382,9 +435,10 @@ fn mesh_serial(
     opts: &MeshOptions,
     mesh: &mut TetMesh,
     sum: &mut Summary,
+    lattice_inner: &mut Vec<u32>,
 ) -> Result<(), MeshError> {
     for rf in fronts {
-        serial_region(s, rf, sizing, opts, mesh, sum)?;
+        serial_region(s, rf, sizing, opts, mesh, sum, lattice_inner)?;
     }
     Ok(())
 }
@@ -397,13 +451,44 @@ fn serial_region(
     opts: &MeshOptions,
     mesh: &mut TetMesh,
     sum: &mut Summary,
+    lattice_inner: &mut Vec<u32>,
 ) -> Result<(), MeshError> {
     let field = |p| sizing.size(p);
-    let (points, point_size) = region_points(s, sizing, rf);
+    let (mut points, mut point_size) = region_points(s, sizing, rf);
+    let mut faces = rf.faces.clone();
+    // §2's optimal space-filling tets: the lattice's points follow the
+    // surface's, its outer faces join the initial front.
+    let n_in = points.len() as u32;
+    let t_lat = Instant::now();
+    let use_lattice = match opts.lattice {
+        LatticeMode::On => true,
+        LatticeMode::Off => false,
+        LatticeMode::Auto => sizing.hmax().is_finite(),
+    };
+    let lattice = if use_lattice {
+        parafront_lattice::build(
+            &points,
+            &point_size,
+            &rf.faces,
+            &field,
+            &LatticeOptions::default(),
+        )
+    } else {
+        Lattice::default()
+    };
+    tracing::debug!(
+        region = rf.region_id,
+        tets = lattice.tets.len(),
+        seconds = t_lat.elapsed().as_secs_f64(),
+        "lattice"
+    );
+    points.extend_from_slice(&lattice.points);
+    point_size.extend_from_slice(&lattice.size);
+    faces.extend(lattice.faces.iter().map(|f| f.map(|v| v + n_in)));
     let input = FrontInput {
         points,
         point_size,
-        faces: rf.faces.clone(),
+        faces,
     };
     let res = advance(
         input,
@@ -445,7 +530,17 @@ fn serial_region(
         }
         Err(e) => return Err(MeshError::Front { region, source: e }),
     };
-    append_region(mesh, rf, &res.points, &res.tets);
+    let mut tets = res.tets;
+    tets.extend(lattice.tets.iter().map(|t| t.map(|v| v + n_in)));
+    let base = append_region(mesh, rf, &res.points, &tets);
+    // The lattice's points are the region's first new points.
+    lattice_inner.extend(
+        (0..lattice.points.len() as u32)
+            .filter(|&k| lattice.interior[k as usize])
+            .map(|k| base + k),
+    );
+    sum.lattice_tets += lattice.tets.len();
+    sum.lattice_cells += lattice.cells;
     sum.recovery_rounds += res.stats.recovery_rounds;
     sum.tets_removed += res.stats.tets_removed;
     sum.cavities_filled += res.stats.cavities_filled;
@@ -553,7 +648,7 @@ fn mesh_parts(
                 sum.stages
                     .push(("passes given up", t_par.elapsed().as_secs_f64()));
                 let t0 = Instant::now();
-                serial_region(s, rf, sizing, opts, mesh, sum)?;
+                serial_region(s, rf, sizing, opts, mesh, sum, &mut Vec::new())?;
                 sum.stages.push(("front", t0.elapsed().as_secs_f64()));
                 continue;
             }

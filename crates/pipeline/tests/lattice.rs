@@ -1,0 +1,83 @@
+//! Optimal space-filling tets (§2, issue 21): with a largest size the
+//! interior is a BCC lattice and the front meshes only around it; the mesh
+//! is valid, keeps the surface, does not depend on the thread count, and
+//! its lattice tets are the ideal ones.
+use parafront_mesh::quality::QualityReport;
+use parafront_pipeline::{mesh_surface, LatticeMode, MeshOptions};
+use parafront_size::SizeOptions;
+use parafront_surface::{generate, Surface};
+
+fn run(
+    s: &Surface,
+    h: f64,
+    lattice: LatticeMode,
+    threads: usize,
+) -> (parafront_mesh::TetMesh, usize) {
+    let o = MeshOptions {
+        size: SizeOptions {
+            h: Some(h),
+            ..SizeOptions::default()
+        },
+        lattice,
+        threads,
+        // Inner bodies as regions: the mesh then keeps every input
+        // triangle as given (the default turns them round, as voids).
+        regions: true,
+        ..MeshOptions::default()
+    };
+    let (m, sum) = mesh_surface(s, &o).unwrap_or_else(|e| panic!("meshing failed: {e}"));
+    m.check_against_surface(&s.tris)
+        .unwrap_or_else(|e| panic!("invalid mesh: {e}"));
+    assert_eq!(QualityReport::new(&m).n_inverted, 0);
+    (m, sum.lattice_tets)
+}
+
+fn volume(m: &parafront_mesh::TetMesh) -> f64 {
+    (0..m.tets.len())
+        .map(|t| {
+            let p = m.tet_points(parafront_mesh::TetId::new(t));
+            parafront_geom::tet_volume6(p[0], p[1], p[2], p[3]) / 6.0
+        })
+        .sum()
+}
+
+#[test]
+fn a_sphere_at_a_uniform_size_is_mostly_lattice() {
+    let s = generate::icosphere([0.0; 3], 1.0, 4);
+    let (m, lat) = run(&s, 0.08, LatticeMode::Auto, 2);
+    assert!(lat * 3 > m.tets.len(), "{lat} of {}", m.tets.len());
+    // The volume is the polyhedron's, whatever the lattice took.
+    let (off, none) = run(&s, 0.08, LatticeMode::Off, 2);
+    assert_eq!(none, 0);
+    assert!((volume(&m) - volume(&off)).abs() < 1e-9 * volume(&off));
+    // Better elements than the front alone.
+    let (q, qo) = (QualityReport::new(&m), QualityReport::new(&off));
+    assert!(
+        q.radius_ratio.mean > qo.radius_ratio.mean,
+        "{} {}",
+        q.radius_ratio.mean,
+        qo.radius_ratio.mean
+    );
+    assert!(q.min_dihedral.min > 10.0, "{}", q.min_dihedral.min);
+}
+
+#[test]
+fn the_lattice_mesh_does_not_depend_on_threads() {
+    let s = generate::demo_part();
+    let (a, la) = run(&s, 0.6, LatticeMode::On, 1);
+    let (b, lb) = run(&s, 0.6, LatticeMode::On, 2);
+    assert!(la > 0);
+    assert_eq!(la, lb);
+    assert_eq!(a.tets, b.tets);
+    assert_eq!(a.points, b.points);
+}
+
+#[test]
+fn auto_leaves_the_graded_default_to_the_front() {
+    let s = generate::icosphere([0.0; 3], 1.0, 3);
+    let (m, lat) = mesh_surface(&s, &MeshOptions::default())
+        .map(|(m, s)| (m, s.lattice_tets))
+        .unwrap();
+    assert_eq!(lat, 0);
+    assert!(!m.tets.is_empty());
+}
