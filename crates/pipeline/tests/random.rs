@@ -2,16 +2,22 @@
 //! perturbed spheres (star-shaped), and spheres whose corners are pulled
 //! onto a neighbour (needle triangles up to 1:10^5). Every one must give a
 //! mesh that keeps the surface and fills it exactly.
-use parafront_pipeline::{mesh_surface, MeshOptions};
+use parafront_pipeline::{mesh_surface, LatticeMode, MeshOptions};
 use parafront_surface::generate::icosphere;
 use parafront_surface::validate::validate;
 use parafront_surface::Surface;
 use proptest::prelude::*;
 
 fn meshes(s: &Surface) -> Result<(), TestCaseError> {
+    meshes_with(s, &MeshOptions::default()).map(|_| ())
+}
+
+/// The mesh keeps the surface and fills it exactly; the tets the lattice
+/// made.
+fn meshes_with(s: &Surface, o: &MeshOptions) -> Result<usize, TestCaseError> {
     prop_assume!(validate(s).is_valid());
-    let (m, _) = mesh_surface(s, &MeshOptions::default())
-        .map_err(|e| TestCaseError::fail(format!("meshing failed: {e}")))?;
+    let (m, sum) =
+        mesh_surface(s, o).map_err(|e| TestCaseError::fail(format!("meshing failed: {e}")))?;
     m.check_against_surface(&s.tris)
         .map_err(|e| TestCaseError::fail(format!("invalid mesh: {e}")))?;
     let v = s.signed_volume();
@@ -20,7 +26,7 @@ fn meshes(s: &Surface) -> Result<(), TestCaseError> {
         "volume {} of {v}",
         m.volume()
     );
-    Ok(())
+    Ok(sum.lattice_tets)
 }
 
 /// Every corner of `s` (a sphere about the origin) at `radius[i]` of its
@@ -42,6 +48,20 @@ proptest! {
         subdiv in 1u32..4,
     ) {
         meshes(&scaled(icosphere([0.0; 3], 1.0, subdiv), &radius))?;
+    }
+
+    /// The lattice (§2) against a bumpy surface, at sizes near its
+    /// edges'. (A surface much coarser than the size, or spikier, stalls
+    /// the front with or without the lattice: issue 20.)
+    #[test]
+    fn bumpy_spheres_mesh_with_the_lattice(
+        radius in prop::collection::vec(0.85f64..1.0, 42),
+        h in 0.06f64..0.1,
+    ) {
+        let mut o = MeshOptions { lattice: LatticeMode::On, ..MeshOptions::default() };
+        o.size.h = Some(h);
+        let lat = meshes_with(&scaled(icosphere([0.0; 3], 1.0, 4), &radius), &o)?;
+        prop_assert!(lat > 0);
     }
 
     /// Corners pulled to within `t` of a neighbour along their edge.
