@@ -4,6 +4,7 @@
 //! check. The CLI is a thin layer over [`mesh_surface`].
 #![forbid(unsafe_code)]
 
+mod lattice;
 mod regions;
 
 pub use parafront_ddg::Partition;
@@ -337,22 +338,16 @@ fn mesh_surface_here(s: &Surface, opts: &MeshOptions) -> Result<(TetMesh, Summar
     }
 
     if opts.optimize > 0 {
-        sum.quality_before = Some(QualityReport::new(&mesh));
+        // The report before improvement is the improvement's cost.
         let t0 = Instant::now();
+        sum.quality_before = Some(QualityReport::new(&mesh));
         // The surface points (ids below s.points.len()) never move (§9.3),
         // nor do the lattice's inner points: their tets are already ideal.
-        let mut frozen = vec![true; s.points.len()];
-        if !lattice_inner.is_empty() {
-            frozen.resize(mesh.points.len(), false);
-            for &p in &lattice_inner {
-                frozen[p as usize] = true;
-            }
-        }
         let io = parafront_improve::ImproveOptions {
             level: opts.optimize,
             parts: opts.optimize_parts,
         };
-        let st = parafront_improve::improve(&mut mesh, &frozen, &io)
+        let st = lattice::improve_around_lattice(&mut mesh, s.points.len(), &lattice_inner, &io)
             .map_err(|e| MeshError::Topology(e.to_string()))?;
         sum.improve = Some(st);
         sum.stages.push(("improve", t0.elapsed().as_secs_f64()));

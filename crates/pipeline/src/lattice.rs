@@ -1,0 +1,69 @@
+//! Improvement (§9) around the lattice (§2): the lattice's inner tets are
+//! ideal and their points frozen, so they are set aside while the rest is
+//! improved, and cost it nothing (issue 21: "lattice tets cost nothing").
+use parafront_improve::{improve, ImproveOptions, ImproveStats};
+use parafront_mesh::{PointId, TetMesh, TopoError};
+
+/// Improves `mesh`, whose first `n_surface` points are the surface's and
+/// `inner` (ids) the lattice's inner points, all frozen. The inner points
+/// are numbered right after the surface's first (improvement drops points
+/// but keeps the ids of those below every dropped one), and the tets of
+/// inner points only are set aside and put back after.
+pub(crate) fn improve_around_lattice(
+    mesh: &mut TetMesh,
+    n_surface: usize,
+    inner: &[u32],
+    io: &ImproveOptions,
+) -> Result<ImproveStats, TopoError> {
+    if inner.is_empty() {
+        return improve(mesh, &vec![true; n_surface], io);
+    }
+    let n = mesh.points.len();
+    let mut new_id = vec![u32::MAX; n];
+    for (i, id) in new_id.iter_mut().enumerate().take(n_surface) {
+        *id = i as u32;
+    }
+    let mut next = n_surface as u32;
+    let mut sorted = inner.to_vec();
+    sorted.sort_unstable();
+    for &p in &sorted {
+        new_id[p as usize] = next;
+        next += 1;
+    }
+    let n_frozen = next as usize;
+    for id in new_id.iter_mut() {
+        if *id == u32::MAX {
+            *id = next;
+            next += 1;
+        }
+    }
+    let mut points = vec![[0.0; 3]; n];
+    for (old, &p) in mesh.points.iter().enumerate() {
+        points[new_id[old] as usize] = p;
+    }
+    mesh.points = points;
+    let inert = |t: &[PointId; 4]| t.iter().all(|p| (n_surface..n_frozen).contains(&p.idx()));
+    let (mut kept, mut kept_region) = (Vec::new(), Vec::new());
+    let (mut aside, mut aside_region) = (Vec::new(), Vec::new());
+    for (t, &r) in mesh.tets.iter().zip(&mesh.region) {
+        let t = t.map(|p| PointId(new_id[p.idx()]));
+        if inert(&t) {
+            aside.push(t);
+            aside_region.push(r);
+        } else {
+            kept.push(t);
+            kept_region.push(r);
+        }
+    }
+    mesh.tets = kept;
+    mesh.region = kept_region;
+    mesh.neigh.clear();
+    let mut st = improve(mesh, &vec![true; n_frozen], io)?;
+    debug_assert!(mesh.points.len() >= n_frozen);
+    mesh.tets.extend_from_slice(&aside);
+    mesh.region.extend_from_slice(&aside_region);
+    mesh.neigh.clear();
+    st.tets_before += aside.len();
+    st.tets_after += aside.len();
+    Ok(st)
+}
