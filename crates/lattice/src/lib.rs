@@ -33,7 +33,10 @@ pub const CUBE_PER_SIZE: f64 = 1.122_462_048_309_373;
 #[derive(Clone, Debug)]
 pub struct LatticeOptions {
     /// Clearance between the lattice and the surface, in cells of the
-    /// block's own size.
+    /// block's own size. Half a cell (about half a tet's height, more where
+    /// the triangles' boxes are larger than they) against one: sphere_1e6
+    /// at --size 0.037 goes from 57 % to 65 % lattice, 7.2 to 6.4 s, min
+    /// dihedral 23.3° to 24.5°; torus_1e6 at 0.032 from 38 % to 47 %.
     pub margin: f64,
     /// Blocks are not made of fewer cells than this (a smaller block saves
     /// the front nothing).
@@ -43,7 +46,7 @@ pub struct LatticeOptions {
 impl Default for LatticeOptions {
     fn default() -> Self {
         LatticeOptions {
-            margin: 1.0,
+            margin: 0.5,
             min_cells: 8,
         }
     }
@@ -122,8 +125,8 @@ mod tests {
         // inner cube of side 1 - 2 * 2 * 0.1123.
         assert!(l.volume > 0.3 && l.volume < 1.0, "{}", l.volume);
         assert!(l.interior.iter().any(|&x| x) && l.interior.iter().any(|&x| !x));
-        // No lattice point within a cell of the surface.
-        let s = CUBE_PER_SIZE * 0.1;
+        // No lattice point within the margin of the surface.
+        let s = LatticeOptions::default().margin * CUBE_PER_SIZE * 0.1;
         for p in &l.points {
             assert!(
                 p.iter().all(|&x| x >= s * 0.999 && x <= 1.0 - s * 0.999),
@@ -183,7 +186,7 @@ mod tests {
         );
         l.check().unwrap();
         assert!(l.cells > 0);
-        let s = CUBE_PER_SIZE * 0.04;
+        let s = LatticeOptions::default().margin * CUBE_PER_SIZE * 0.04;
         for p in &l.points {
             let in_void = p
                 .iter()
