@@ -277,7 +277,8 @@ def write(a, sections, started, threads, peers):
         pass
     L = []
     if a.append:
-        L.append(f"## Sitting {started} (commit {rev}): `scripts/bench.py --sets {a.sets} "
+        only = f" --only {a.only}" if a.only else ""
+        L.append(f"## Sitting {started} (commit {rev}): `scripts/bench.py --sets {a.sets}{only} "
                  f"--threads {a.threads} --repeat {a.repeat} --peers {a.peers or 'none'}`\n")
     else:
         header(L, a, started, rev, cpu)
@@ -334,7 +335,8 @@ def header(L, a, started, rev, cpu):
     L.append("# Benchmarks\n")
     L.append("Written by `scripts/bench.py`; do not edit by hand. To reproduce:\n")
     L.append("```\ncargo build --release -p parafront\npip install numpy meshio gmsh tetgen netgen-mesher\n"
-             f"python3 scripts/bench.py --sets {a.sets} --threads {a.threads} --repeat {a.repeat} "
+             f"python3 scripts/bench.py --sets {a.sets}{' --only ' + a.only if a.only else ''} "
+             f"--threads {a.threads} --repeat {a.repeat} "
              f"--peers {a.peers or 'none'}\n```\n")
     L.append(f"Sitting: {started}, commit {rev}, {os.cpu_count()} cores ({cpu}).\n")
     L.append("- **parafront**: the whole `parafront mesh` run as a user times it (default options, "
