@@ -37,9 +37,13 @@ impl<'a> Front<'a> {
                 .map(|faces| fill_cavity(pts, faces, &fopts))
                 .collect();
             let mut failed: Vec<u32> = Vec::new();
+            let mut closed = 0;
             for ((ids, faces), fill) in comps.iter().zip(&cavities).zip(fills) {
                 match fill {
-                    Ok(fill) => self.apply_fill(faces, fill, n0),
+                    Ok(fill) => {
+                        closed += 1;
+                        self.apply_fill(faces, fill, n0)
+                    }
                     Err(e) => {
                         tracing::debug!(faces = faces.len(), error = %e, "cavity not filled");
                         failed.extend_from_slice(ids);
@@ -49,7 +53,8 @@ impl<'a> Front<'a> {
             if failed.is_empty() {
                 return true;
             }
-            if round == growth {
+            // A growth round that closed nothing is not followed by more.
+            if round == growth || (round > 0 && closed == 0) {
                 break;
             }
             // Grow each cavity left by the tets behind its faces.
