@@ -109,7 +109,8 @@ pub struct FrontOptions {
     /// `FrontError::Stuck` where the fill would start.
     pub fill: bool,
     /// Times a cavity the fill cannot close is grown by the tets behind
-    /// its faces before the front gives up.
+    /// its faces before the front gives up (fewer when a growth round
+    /// closes no cavity).
     pub fill_growth: u32,
     /// Recovery rounds before the fill takes over, and between its tries
     /// (issue 20: a stalled region costs a few rounds, not minutes); 0: only
