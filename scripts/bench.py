@@ -117,6 +117,8 @@ def parse_summary(out):
     m = re.search(r"^recovery: (\d+) rounds", out, re.M)
     r["recovery_rounds"] = int(m.group(1)) if m else 0
     r["region_fill"] = "filled whole" in out
+    m = re.search(r"^lattice: \d+ tets in \d+ cubes, ([\d.]+)% of the tets", out, re.M)
+    r["lattice_pct"] = float(m.group(1)) if m else None
     return r
 
 
@@ -223,7 +225,9 @@ def main():
                              last.get("pct10"), last.get("rr"),
                              "yes" if valid else "NO",
                              f"{last['fill_cavities']} / {last['fill_tets']}"
-                             + (" (region)" if last["region_fill"] else "")])
+                             + (" (region)" if last["region_fill"] else "")
+                             + (f"; lattice {last['lattice_pct']:.0f} %"
+                                if last["lattice_pct"] is not None else "")])
                 stages = {}
                 for r in runs:
                     for k, v in r.get("stages", {}).items():
@@ -349,7 +353,8 @@ def header(L, a, started, rev, cpu):
              "worst min dihedral, share of tets with a dihedral under 10°, mean radius ratio.")
     L.append("- valid: `meshcheck.py --surface` on parafront's mesh (against the healed surface "
              "for dirty/ inputs). fill: cavities closed by the constrained fill / its tets "
-             "(region: a region filled whole). Peers mesh the healed surface of dirty/ inputs, "
+             "(region: a region filled whole), and the lattice's share of the tets (§2's "
+             "optimal space-filling tets) where it ran. Peers mesh the healed surface of dirty/ inputs, "
              "and take `--h` from an input's `--size` where it has one.\n")
 
 
