@@ -20,7 +20,7 @@ mod bcc;
 mod inside;
 mod octree;
 
-pub use bcc::Lattice;
+pub use bcc::{Lattice, LatticeCheckError};
 
 use parafront_geom::P3;
 
