@@ -14,7 +14,7 @@
 //! with fewer tets under [`SMALL_DIHEDRAL`] and a min dihedral no lower; or, for
 //! a tet under [`LIFT_DEG`], when the cavity's min dihedral rises.
 use crate::ops::{positive, Cand, MARGIN};
-use crate::quality::{min_dihedral_deg, quality};
+use crate::quality::{has_dihedral_under, min_dihedral_deg, quality};
 use crate::work::{ring_tets, Work};
 use parafront_geom::{cross, dist2, norm, sub, P3};
 use parafront_mesh::quality::TET_EDGES;
@@ -29,6 +29,9 @@ pub(crate) use parafront_mesh::quality::SMALL_DIHEDRAL;
 pub(crate) const LIFT_DEG: f64 = 0.1;
 /// The min dihedral (degrees) a lift aims at before it minds the count.
 pub(crate) const LIFT_GOAL: f64 = 0.2;
+/// The angle (degrees) from which a tet adds nothing to a star's count or
+/// shortfall ([`Score::add_angle`]).
+const SHORT_DEG: f64 = 12.0;
 /// Cavity kinds ([`Work::cavity`]).
 const CAVITIES: usize = 11;
 /// Largest cavity (tets) considered.
@@ -68,7 +71,7 @@ impl Score {
     /// Adds a tet of min dihedral `d`.
     fn add_angle(&mut self, d: f64) {
         self.under += usize::from(d < SMALL_DIHEDRAL);
-        self.short += (12.0 - d).max(0.0);
+        self.short += (SHORT_DEG - d).max(0.0);
         self.dmin = self.dmin.min(d);
     }
 
@@ -154,6 +157,12 @@ impl Work<'_> {
         lift: Option<f64>,
         bound: Option<Key>,
     ) -> Option<Score> {
+        // A tet with no angle under `clamp` adds nothing to a key but its
+        // min dihedral, which the key clamps there: it is taken as `clamp`
+        // without the arc tangent ([`Self::exact_score`] gives the kept
+        // star's true one).
+        let clamp = lift.map_or(SHORT_DEG, |g| g.max(SHORT_DEG));
+        let tan_clamp = clamp.to_radians().tan();
         let mut sc = Score::NONE;
         for &(v, f) in star {
             let mut x = self.pts(v);
@@ -161,12 +170,28 @@ impl Work<'_> {
             if !positive(x) {
                 return None;
             }
-            sc.add_angle(min_dihedral_deg(x));
+            let d = if has_dihedral_under(x, tan_clamp) {
+                min_dihedral_deg(x)
+            } else {
+                clamp
+            };
+            sc.add_angle(d);
             if bound.is_some_and(|b| cannot_beat(sc.key(old, lift), b)) {
                 return None;
             }
         }
         Some(sc)
+    }
+
+    /// The star's score with every min dihedral taken exactly.
+    fn exact_score(&self, star: &[([PointId; 4], usize)], pos: P3) -> Score {
+        let mut sc = Score::NONE;
+        for &(v, f) in star {
+            let mut x = self.pts(v);
+            x[f] = pos;
+            sc.add_angle(min_dihedral_deg(x));
+        }
+        sc
     }
 
     /// The star's worst mean ratio with the new point at `pos`.
@@ -313,7 +338,7 @@ impl Work<'_> {
         } else {
             (20, 1e-2)
         };
-        let (sc, pos) = crate::ops::compass(
+        let (_, pos) = crate::ops::compass(
             pos,
             sc,
             0.3 * len,
@@ -325,6 +350,7 @@ impl Work<'_> {
             },
             |n, cur| less(n.key(&old, lift), cur.key(&old, lift)),
         );
+        let sc = self.exact_score(&s.best_star, pos);
         let ok = (sc.under < old.under && sc.dmin >= old.dmin)
             || (lift.is_some()
                 && sc.dmin > old.dmin * (1.0 + MARGIN) + 1e-9
@@ -557,6 +583,30 @@ impl Work<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A tet the cheap test passes has its min dihedral at the clamp or
+    /// above, so taking it as the clamp leaves every key as it was.
+    #[test]
+    fn a_tet_with_no_angle_under_the_clamp_has_its_min_there_or_above() {
+        let mut x = 0x5151_7a7a_0f0f_3c3cu64;
+        let mut r = || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            (x >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut passed = 0;
+        for _ in 0..50_000 {
+            let p: [P3; 4] = std::array::from_fn(|_| [r(), r(), r()]);
+            for clamp in [SHORT_DEG, 18.0] {
+                if !has_dihedral_under(p, clamp.to_radians().tan()) {
+                    passed += 1;
+                    assert!(min_dihedral_deg(p) >= clamp * (1.0 - 1e-12), "{p:?}");
+                }
+            }
+        }
+        assert!(passed > 1000, "{passed}");
+    }
 
     /// The search's pruning is sound: a star whose first tets cannot beat
     /// a key never does, whatever tets follow.
