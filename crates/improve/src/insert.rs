@@ -92,6 +92,27 @@ impl Score {
 
 type Key = (f64, isize, f64);
 
+/// How the insertion's search ranks stars: the lift it aims at, and the
+/// angle from which a tet adds nothing to a key but its min dihedral,
+/// which the key clamps there. Such a tet is scored at the clamp without
+/// its arc tangent ([`Work::exact_score`] gives the kept star's true one).
+struct Rank {
+    lift: Option<f64>,
+    clamp: f64,
+    tan_clamp: f64,
+}
+
+impl Rank {
+    fn new(lift: Option<f64>) -> Rank {
+        let clamp = lift.map_or(SHORT_DEG, |g| g.max(SHORT_DEG));
+        Rank {
+            lift,
+            clamp,
+            tan_clamp: clamp.to_radians().tan(),
+        }
+    }
+}
+
 fn less(a: Key, b: Key) -> bool {
     a.0 < b.0 - 1e-12 || (a.0 <= b.0 && (a.1 < b.1 || (a.1 == b.1 && a.2 < b.2 - 1e-9)))
 }
@@ -147,22 +168,17 @@ impl Work<'_> {
     }
 
     /// The star's angle score with the new point at `pos` (relative to the
-    /// cavity's `old` one, under `lift`); `None` when a tet is not positive
-    /// or once the star cannot be [`less`] than `bound`.
+    /// cavity's `old` one, under `rank`'s lift); `None` when a tet is not
+    /// positive or once the star cannot be [`less`] than `bound`.
     fn score_star(
         &self,
         star: &[([PointId; 4], usize)],
         pos: P3,
         old: &Score,
-        lift: Option<f64>,
+        rank: &Rank,
         bound: Option<Key>,
     ) -> Option<Score> {
-        // A tet with no angle under `clamp` adds nothing to a key but its
-        // min dihedral, which the key clamps there: it is taken as `clamp`
-        // without the arc tangent ([`Self::exact_score`] gives the kept
-        // star's true one).
-        let clamp = lift.map_or(SHORT_DEG, |g| g.max(SHORT_DEG));
-        let tan_clamp = clamp.to_radians().tan();
+        let (lift, clamp, tan_clamp) = (rank.lift, rank.clamp, rank.tan_clamp);
         let mut sc = Score::NONE;
         for &(v, f) in star {
             let mut x = self.pts(v);
@@ -301,6 +317,7 @@ impl Work<'_> {
                 }
             }
         }
+        let rank = Rank::new(lift);
         let mut best: Option<(Score, Score, P3)> = None;
         for k in 0..CAVITIES {
             if !self.cavity(t, k, s) || !self.star_of(s) {
@@ -309,7 +326,7 @@ impl Work<'_> {
             let old = self.score_old(&s.cav);
             for &p in &cands {
                 let bound = best.as_ref().map(|b| b.0.key(&b.1, lift));
-                if let Some(sc) = self.score_star(&s.star, p, &old, lift, bound) {
+                if let Some(sc) = self.score_star(&s.star, p, &old, &rank, bound) {
                     if bound.is_none_or(|b| less(sc.key(&old, lift), b)) {
                         best = Some((sc, old, p));
                         s.best_star.clear();
@@ -346,7 +363,7 @@ impl Work<'_> {
             iters,
             |p, cur| {
                 let bound = Some(cur.key(&old, lift));
-                self.score_star(&s.best_star, p, &old, lift, bound)
+                self.score_star(&s.best_star, p, &old, &rank, bound)
             },
             |n, cur| less(n.key(&old, lift), cur.key(&old, lift)),
         );
@@ -588,13 +605,7 @@ mod tests {
     /// above, so taking it as the clamp leaves every key as it was.
     #[test]
     fn a_tet_with_no_angle_under_the_clamp_has_its_min_there_or_above() {
-        let mut x = 0x5151_7a7a_0f0f_3c3cu64;
-        let mut r = || {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
-            (x >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut r = crate::test_rng(0x5151_7a7a_0f0f_3c3cu64);
         let mut passed = 0;
         for _ in 0..50_000 {
             let p: [P3; 4] = std::array::from_fn(|_| [r(), r(), r()]);
@@ -612,13 +623,7 @@ mod tests {
     /// a key never does, whatever tets follow.
     #[test]
     fn a_pruned_star_never_beats_the_bound() {
-        let mut x = 0x1234_5678_9abc_def1u64;
-        let mut r = || {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
-            (x >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut r = crate::test_rng(0x1234_5678_9abc_def1u64);
         let mut pruned = 0;
         for k in 0..20_000 {
             let lift = (k % 2 == 0).then_some(LIFT_GOAL);

@@ -32,6 +32,17 @@ pub mod parallel;
 pub mod quality;
 mod work;
 
+/// The tests' random numbers: xorshift64, uniform in [0, 1).
+#[cfg(test)]
+pub(crate) fn test_rng(mut x: u64) -> impl FnMut() -> f64 {
+    move || {
+        x ^= x << 13;
+        x ^= x >> 7;
+        x ^= x << 17;
+        (x >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
 pub use ops::Outcome;
 
 use ops::{Cand, Scratch};

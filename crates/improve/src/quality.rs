@@ -176,13 +176,8 @@ mod tests {
     #[test]
     fn one_arc_tangent_gives_the_six_angles_minimum() {
         // Random tets, inverted ones and near-flat ones among them.
-        let mut x = 0x9e37_79b9_7f4a_7c15u64;
-        let mut r = || {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
-            (x >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
+        let mut u = crate::test_rng(0x9e37_79b9_7f4a_7c15u64);
+        let mut r = || u() - 0.5;
         for k in 0..10_000 {
             let mut p = [[0.0; 3]; 4];
             for q in &mut p {
@@ -204,13 +199,8 @@ mod tests {
     #[test]
     fn positive_quality_is_the_exact_test_then_the_mean_ratio() {
         use parafront_geom::orient3d;
-        let mut x = 0x2545_f491_4f6c_dd1du64;
-        let mut r = || {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
-            (x >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
+        let mut u = crate::test_rng(0x2545_f491_4f6c_dd1du64);
+        let mut r = || u() - 0.5;
         let (mut near, mut neg) = (0, 0);
         for k in 0..20_000 {
             let mut p = [[0.0; 3]; 4];

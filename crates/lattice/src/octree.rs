@@ -66,13 +66,13 @@ pub(crate) fn blocks(
     let extent = (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max);
     // The levels' sizes: the largest size in the region, halved per level
     // (a uniform field is then exactly a level's size).
-    let mut hmax: f64 = 0.0;
-    let mut hmin = f64::INFINITY;
+    let (mut hmin, mut hmax, mut hsum) = (f64::INFINITY, 0.0f64, 0.0);
     for f in faces {
         for &v in f {
             let h = point_size[v as usize];
             hmin = hmin.min(h);
             hmax = hmax.max(h);
+            hsum += h;
         }
     }
     let n = 6;
@@ -92,12 +92,11 @@ pub(crate) fn blocks(
     // radius, 1.5 times a slab's thickness) has no room for a cell between
     // its margins at the surface's mean size: the octree would be
     // searched in vain.
-    let (mut vol6, mut area2, mut hsum) = (0.0, 0.0, 0.0);
+    let (mut vol6, mut area2) = (0.0, 0.0);
     for f in faces {
         let [a, b, c] = f.map(|v| points[v as usize]);
         vol6 += parafront_geom::tet_volume6(a, b, c, lo);
         area2 += parafront_geom::norm(parafront_geom::tri_normal(a, b, c));
-        hsum += f.iter().map(|&v| point_size[v as usize]).sum::<f64>();
     }
     // A ball's radius; a slab's thickness is 2/3 of it.
     let depth = 3.0 * (vol6 / 6.0) / (0.5 * area2);
