@@ -1,4 +1,4 @@
-//! The constrained fill of a closed cavity (issue 20), in order: the
+//! The constrained fill of a closed cavity, in order: the
 //! Delaunay tetrahedralization of its points with its faces recovered by
 //! flips and the tets outside removed; the cone from its kernel's deepest
 //! point (a star-shaped cavity); the search (`search.rs`); Steiner points

@@ -1,5 +1,5 @@
 //! The Delaunay kernel, and the constrained fill of a cavity the front
-//! cannot close (issue 20).
+//! cannot close (AF5's last resort).
 //!
 //! The paper's §2 names the two scalar methods, the advancing front and the
 //! generalized Delaunay triangulation (GDT). This crate is the second's

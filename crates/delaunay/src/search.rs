@@ -1,4 +1,4 @@
-//! The fill's second method (issue 20): a cavity the constrained Delaunay
+//! The fill's second method: a cavity the constrained Delaunay
 //! recovery leaves open is tiled by a search. It is the front again, freed
 //! of the front's quality rules and able to take a step back: every front
 //! face keeps the apexes whose tet lies in the cavity (exact tests), the

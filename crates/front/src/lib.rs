@@ -44,7 +44,7 @@ impl Progress {
     pub fn rounds(&self) -> u64 {
         self.rounds.load(Ordering::Relaxed)
     }
-    /// Constrained fills started so far (issue 20).
+    /// Constrained fills started so far.
     pub fn fills(&self) -> u64 {
         self.fills.load(Ordering::Relaxed)
     }

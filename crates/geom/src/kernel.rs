@@ -1,6 +1,6 @@
 //! The deepest point of an intersection of half-spaces (a polyhedron's
 //! kernel): the point that sees every face of a pocket from furthest away,
-//! for recovery's cones (issue 3, step 5.3).
+//! for recovery's cones (step 5.3).
 //!
 //! It is a small linear program, max t subject to n_i.x - t >= n_i.p_i,
 //! solved through its dual (4 equality rows, one column per plane) by a

@@ -13,7 +13,7 @@
 //!
 //! - A last polish moves the free points of tets under 1° to raise their
 //!   ball's min dihedral, within a tenth of the ball's worst mean ratio.
-//! - For the tets under 10° (issue 5), after all that: their free points
+//! - For the tets under 10°, after all that: their free points
 //!   move and swaps are done to leave fewer of them, and new points go in
 //!   (Steiner points, not in the paper: `insert.rs`); in serial runs and
 //!   in the final polish of a parallel one (parts keep their point ids).
@@ -506,7 +506,7 @@ impl<'m> Improver<'m> {
         st.insert.seconds += t0.elapsed().as_secs_f64();
     }
 
-    /// For the share of tets under 10° (issue 5): moves, swaps, point
+    /// For the share of tets under 10°: moves, swaps, point
     /// insertion, moves, swaps, moves. Measured on the
     /// tray (5,090 such tets after the passes before): moves alone leave
     /// 3,962; moves, insertion and moves 3,368; with the swaps 3,051;

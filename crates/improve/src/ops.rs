@@ -1,8 +1,8 @@
 //! The local operations of §9: face swap 2-3 and edge removal (3-2 and
 //! n -> 2n-4, §9.1), edge collapse (§9.2), Laplacian smoothing with move
 //! rejection (§9.3), selective movement along edges (§9.4) and two moves
-//! for the dihedral angles (the last polish, and fewer tets under 10°,
-//! for issue 5). Each first evaluates a candidate without touching the
+//! for the dihedral angles (the last polish, and fewer tets under 10°).
+//! Each first evaluates a candidate without touching the
 //! mesh and keeps it only when the worst quality of the tets it makes
 //! beats the worst of those it replaces, and every new tet is positive
 //! under the exact predicate and in floating point.
@@ -605,7 +605,7 @@ impl Work<'_> {
                 }
                 let dt = min_dihedral_deg(x);
                 d = d.min(dt);
-                under += usize::from(dt < 10.0);
+                under += usize::from(dt < crate::insert::SMALL_DIHEDRAL);
             }
             Some((d, under))
         };
@@ -664,7 +664,7 @@ impl Work<'_> {
                     }
                 }
                 let d = min_dihedral_deg(x);
-                under += usize::from(d < 10.0);
+                under += usize::from(d < crate::insert::SMALL_DIHEDRAL);
                 if under > cap || d < floor || !positive(x) {
                     return None;
                 }

@@ -1,26 +1,12 @@
 //! The one quality measure every operation uses: the mean ratio,
-//! `12 (3|V|)^(2/3) / sum l^2`, signed by the volume. Smooth, scale
-//! invariant, 1 for the regular tet, 0 for a flat one, and cheap (a cube
-//! root, no arc-cosines; §9.4 warns about their cost). It equals
-//! `parafront_mesh::quality::mean_ratio`.
-use parafront_geom::{dist2, tet_volume6, P3};
+//! `12 (3|V|)^(2/3) / sum l^2`, signed by the volume
+//! (`parafront_mesh::quality::mean_ratio`). Smooth, scale invariant, 1 for
+//! the regular tet, 0 for a flat one, and cheap (a cube root, no
+//! arc-cosines; §9.4 warns about their cost).
+use parafront_geom::{tet_volume6, P3};
+use parafront_mesh::quality::{edge_length2_sum, mean_ratio_of};
 
-#[inline]
-pub fn quality(p: [P3; 4]) -> f64 {
-    let v6 = tet_volume6(p[0], p[1], p[2], p[3]);
-    let l2 = dist2(p[0], p[1])
-        + dist2(p[0], p[2])
-        + dist2(p[0], p[3])
-        + dist2(p[1], p[2])
-        + dist2(p[1], p[3])
-        + dist2(p[2], p[3]);
-    if l2 > 0.0 {
-        let v3 = 0.5 * v6; // 3V
-        (12.0 * (v3 * v3).cbrt() / l2).copysign(v6)
-    } else {
-        0.0
-    }
-}
+pub use parafront_mesh::quality::mean_ratio as quality;
 
 /// `6V` of a tet that is positive both in floating point and exactly,
 /// else `None`. The exact predicate runs only where the float
@@ -49,18 +35,7 @@ pub fn positive_volume6(p: [P3; 4]) -> Option<f64> {
 #[inline]
 pub fn positive_quality(p: [P3; 4]) -> Option<f64> {
     let v6 = positive_volume6(p)?;
-    let l2 = dist2(p[0], p[1])
-        + dist2(p[0], p[2])
-        + dist2(p[0], p[3])
-        + dist2(p[1], p[2])
-        + dist2(p[1], p[3])
-        + dist2(p[2], p[3]);
-    if l2 > 0.0 {
-        let v3 = 0.5 * v6;
-        Some(12.0 * (v3 * v3).cbrt() / l2)
-    } else {
-        Some(0.0)
-    }
+    Some(mean_ratio_of(v6, edge_length2_sum(p)))
 }
 
 /// Each edge of a tet (its first two corners) with the two other corners.
@@ -133,16 +108,27 @@ mod tests {
     use super::*;
 
     #[test]
-    fn matches_the_mesh_crate() {
+    fn is_the_mean_ratio() {
         let p = [
             [0.0, 0.0, 0.0],
             [1.0, 0.1, 0.0],
             [0.2, 0.9, 0.1],
             [0.3, 0.2, 0.7],
         ];
+        // 12 (3V)^(2/3) / sum l^2, written out.
+        let v = tet_volume6(p[0], p[1], p[2], p[3]) / 6.0;
+        let l2: f64 = (0..4)
+            .flat_map(|i| (i + 1..4).map(move |j| (i, j)))
+            .map(|(i, j)| parafront_geom::dist2(p[i], p[j]))
+            .sum();
+        let want = 12.0 * (3.0 * v).powf(2.0 / 3.0) / l2;
         let a = quality(p);
-        let b = parafront_mesh::quality::mean_ratio(p);
-        assert!((a - b).abs() < 1e-12, "{a} {b}");
+        assert!(v > 0.0 && (a - want).abs() < 1e-12, "{a} {want}");
+        assert_eq!(positive_quality(p), Some(a));
+        assert!(
+            quality([p[1], p[0], p[2], p[3]]) == -a
+                && positive_quality([p[1], p[0], p[2], p[3]]).is_none()
+        );
         let r = [
             [1.0, 1.0, 1.0],
             [1.0, -1.0, -1.0],

@@ -1,5 +1,5 @@
 //! Optimal space-filling tets (the paper's §2 names them as an option of
-//! the scalar front; issue 21): away from the surface, where the size
+//! the scalar front): away from the surface, where the size
 //! field is nearly uniform, the volume is filled directly with a
 //! body-centred cubic (BCC) lattice of near-ideal tets (dihedral angles of
 //! 60° and 90°, mean ratio 0.95) instead of point by point.

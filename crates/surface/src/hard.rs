@@ -1,4 +1,4 @@
-//! Hard surfaces (issue 20), made in code: needles, twisted prisms (no
+//! Hard surfaces, made in code: needles, twisted prisms (no
 //! triangulation without a Steiner point), thin slots, thin rods, a tiny
 //! feature beside large faces. The tests mesh them; `examples/hard_surfaces`
 //! in the CLI writes them for the benchmark script and the peers.

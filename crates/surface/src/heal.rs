@@ -1,4 +1,4 @@
-//! Healing of dirty CAD surfaces (issue 23): closes what a float rounding
+//! Healing of dirty CAD surfaces: closes what a float rounding
 //! opened, and nothing else.
 //!
 //! CAD exports sometimes write the same vertex twice with coordinates a

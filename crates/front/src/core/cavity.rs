@@ -1,4 +1,4 @@
-//! Recovery's last resort (issue 3, step 5.3): a pocket of stuck faces is
+//! Recovery's last resort (step 5.3): a pocket of stuck faces is
 //! grown, by removing the tet behind each face it sees badly, until one
 //! inner point sees every face well; the pocket is then filled by coning
 //! its faces to that point. A closed pocket whose every face sees the point

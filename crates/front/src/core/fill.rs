@@ -1,5 +1,5 @@
 //! A stalled front hands its cavities to the constrained Delaunay fill
-//! (issue 20; `parafront_delaunay::fill_cavity`). Each cavity is a closed
+//! (`parafront_delaunay::fill_cavity`). Each cavity is a closed
 //! component of the live front; one the fill cannot close is grown by
 //! removing the tets behind its faces, a bounded number of times. The
 //! fills are computed in parallel and applied in cavity order, so the mesh

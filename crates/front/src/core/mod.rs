@@ -57,7 +57,7 @@ const LATE_REMOVAL_POINTS: usize = 2;
 pub const MAX_GROWTH_PER_TET: f64 = 2.0;
 
 /// Recovery rounds before the constrained fill takes over
-/// (`FrontOptions::fill_after`). On the corpus (issue 20, session 15): 4
+/// (`FrontOptions::fill_after`). On the corpus: 4
 /// closes round.stl in 6 s where 10 took 6 s and 200 failed; 1 and 2 fill
 /// larger, harder cavities (the tray takes 40-70 s).
 pub const DEFAULT_FILL_AFTER: u32 = 4;
@@ -98,14 +98,14 @@ pub struct FrontOptions {
     /// nothing.
     pub pass: bool,
     /// On failure, hand back the partial mesh and the stuck front in
-    /// `FrontError::Stuck` (issue 3, step 5.4: a debug dump when asked).
+    /// `FrontError::Stuck` (step 5.4: a debug dump when asked).
     pub keep_partial: bool,
     /// A new tet's size is at most this multiple of its face's longest
     /// edge: sizes then grow geometrically, and a small face under a large
     /// size (CAD needles) keeps a local search. The DDG allows more.
     pub max_growth: f64,
     /// Hand a stalled front's cavities to the constrained Delaunay fill
-    /// (issue 20) instead of failing. Off, the front stops with
+    /// instead of failing. Off, the front stops with
     /// `FrontError::Stuck` where the fill would start.
     pub fill: bool,
     /// Times a cavity the fill cannot close is grown by the tets behind
@@ -113,7 +113,7 @@ pub struct FrontOptions {
     /// closes no cavity).
     pub fill_growth: u32,
     /// Recovery rounds before the fill takes over, and between its tries
-    /// (issue 20: a stalled region costs a few rounds, not minutes); 0: only
+    /// (a stalled region costs a few rounds, not minutes); 0: only
     /// where the front would give up. Where the fill cannot close a cavity
     /// yet, recovery goes on.
     pub fill_after: u32,
