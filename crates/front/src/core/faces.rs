@@ -83,7 +83,7 @@ impl<'a> Front<'a> {
     /// asked.
     pub(super) fn commit(&mut self, fid: u32, q: u32, pq: P3, matched: Option<[u32; 3]>) {
         let v = self.fv[fid as usize].v;
-        let q = if is_new_point(q) {
+        let q = if policy::is_new_point(q) {
             let id = self.pts.len() as u32;
             let h = self.new_point_size(v, pq);
             self.pts.push(pq);

@@ -17,9 +17,10 @@ mod exhaustive;
 mod faces;
 mod fill;
 mod free;
+mod policy;
 mod recover;
 
-use free::Clearance;
+use policy::Clearance;
 
 /// Smallest mean ratio the front accepts: a flatter tet may be positive
 /// only in exact arithmetic, and a solver reads it as inverted.
@@ -71,8 +72,6 @@ pub const DEFAULT_FILL_AFTER: u32 = 4;
 const FILL_TRIES: u32 = 1;
 
 const NONE: u32 = u32::MAX;
-/// How far a new point keeps from front faces, in sizes, by round.
-const NEW_POINT_CLEARANCE: [f64; 3] = [0.3, 0.2, 0.1];
 /// How far a new edge keeps from front edges, in point clearances.
 const EDGE_CLEARANCE: f64 = 2.0;
 
@@ -326,13 +325,6 @@ struct Front<'a> {
     /// Per point: the query that last saw it (dedups corners of faces).
     stamp: Vec<u32>,
     epoch: u32,
-}
-
-/// A candidate apex that is not a point yet: `NONE - k` codes the k-th
-/// height above the face in `try_face`, `NONE` a cone apex in recovery.
-#[inline]
-fn is_new_point(q: u32) -> bool {
-    q >= NONE - 3
 }
 
 /// Each of `g`'s ids' index in `tv`, or 4: by selects, not `position`
