@@ -7,7 +7,7 @@ mod surface_cmds;
 use clap::{Args, Parser, Subcommand};
 use parafront_io::{read_mesh, write_mesh, MshVersion, WriteOptions};
 use parafront_mesh::QualityReport;
-use parafront_pipeline::{mesh_surface, MeshError, MeshOptions, Summary};
+use parafront_pipeline::{mesh_surface, MeshError, MeshOptions, Stage, Summary};
 use parafront_surface::read::read_surface;
 use parafront_surface::validate::validate;
 use parafront_surface::Surface;
@@ -416,7 +416,7 @@ fn run_mesh(s: &Surface, name: &str, out: &Path, a: &MeshArgs, w: &WriteArgs) ->
     };
     let t0 = Instant::now();
     write_mesh(out, &mesh, &wopts)?;
-    sum.stages.push(("write", t0.elapsed().as_secs_f64()));
+    sum.push(Stage::Write, t0.elapsed().as_secs_f64());
     print_summary(&sum);
     parallel::print_parallel(&sum);
     println!("wrote {}", out.display());
@@ -517,7 +517,7 @@ impl ProgressLine {
 }
 
 fn print_summary(sum: &Summary) {
-    let front = sum.seconds("front");
+    let front = sum.seconds(Stage::Front);
     println!(
         "{} tets, {} points, {} region{}",
         sum.tets,

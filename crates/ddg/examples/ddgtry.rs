@@ -9,11 +9,9 @@ fn main() {
         s.mean_edge_lengths(),
         faces,
         c,
-        parafront_ddg::DdgMode::default(),
     ) {
         Ok(d) => println!(
-            "c={c} {:?}: {} tets, {} points ({} surface), {:.2} s",
-            d.mode,
+            "c={c}: {} tets, {} points ({} surface), {:.2} s",
             d.tets.len(),
             d.points.len(),
             d.n_input,

@@ -484,7 +484,6 @@ mod tests {
             s.mean_edge_lengths(),
             faces,
             crate::DEFAULT_GROWTH,
-            crate::DdgMode::default(),
         )
         .unwrap()
     }

@@ -98,10 +98,11 @@ pub(crate) fn run<C: Comm>(
                         pc.points.len() as u32 - 1
                     });
                     if pc.gid[i as usize] != g {
-                        return Err(PassError::Redistribute(format!(
-                            "points {} and {g} are both at {p:?}",
-                            pc.gid[i as usize]
-                        )));
+                        return Err(PassError::Coincident {
+                            a: pc.gid[i as usize],
+                            b: g,
+                            at: p,
+                        });
                     }
                     tv[c] = i;
                 }
@@ -211,9 +212,7 @@ pub(crate) fn run<C: Comm>(
         tet_pass.extend_from_slice(&pc.tet_pass);
     }
     if let Some(g) = seen.iter().position(|&s| !s) {
-        return Err(PassError::Redistribute(format!(
-            "point {g} is in no tet of any part"
-        )));
+        return Err(PassError::Unused { point: g as u32 });
     }
     let _ = np;
     Ok(ParOutput {

@@ -46,8 +46,12 @@ pub enum SizeError {
     Io { path: PathBuf, msg: String },
     #[error("size options: {what}: {why}")]
     Invalid { what: String, why: String },
-    #[error("surface: {0}")]
-    Surface(String),
+    /// A surface point with a NaN or infinite coordinate.
+    #[error("surface: point {point} has non-finite coordinates {at:?}")]
+    NonFinitePoint { point: usize, at: P3 },
+    /// A triangle naming a point past the end of the surface's points.
+    #[error("surface: triangle {tri} refers to point {point}, but there are {points} points")]
+    PointOutOfRange { tri: usize, point: u32, points: usize },
     #[error("surface point {point} at {at:?} gets no usable size ({size}) from its incident edges (zero or overflowing lengths; set hmin > 0 or fix the surface)")]
     ZeroSize { point: usize, at: P3, size: f64 },
     #[error("background grid: {why}")]
@@ -100,16 +104,16 @@ impl Sizing {
         let np = surface.points.len();
         for (i, p) in surface.points.iter().enumerate() {
             if !p.iter().all(|x| x.is_finite()) {
-                return Err(SizeError::Surface(format!(
-                    "point {i} has non-finite coordinates {p:?}"
-                )));
+                return Err(SizeError::NonFinitePoint { point: i, at: *p });
             }
         }
         for (t, tri) in surface.tris.iter().enumerate() {
             if let Some(v) = tri.iter().find(|&&v| v as usize >= np) {
-                return Err(SizeError::Surface(format!(
-                    "triangle {t} refers to point {v}, but there are {np} points"
-                )));
+                return Err(SizeError::PointOutOfRange {
+                    tri: t,
+                    point: *v,
+                    points: np,
+                });
             }
         }
 
