@@ -1,5 +1,7 @@
 //! `parafront`: the command line. A thin layer: each subcommand parses its
 //! flags into the library's option structs and calls one function.
+// Not forbid: resetting SIGPIPE (in `main`) needs one unsafe call.
+#![deny(unsafe_code)]
 mod parallel;
 mod plot;
 mod surface_cmds;
@@ -230,6 +232,7 @@ fn main() -> ExitCode {
     // panicked; the default action ends the process quietly, as for any
     // Unix tool. Meshes go to files (written aside, then renamed), never
     // to a pipe.
+    #[allow(unsafe_code)]
     unsafe {
         libc::signal(libc::SIGPIPE, libc::SIG_DFL);
     }

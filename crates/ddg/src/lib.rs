@@ -4,6 +4,7 @@
 //! (§6, step 2), the shifted partitions of passes 2 and 3 and the region
 //! filter of one part (§7).
 #![forbid(unsafe_code)]
+#![warn(missing_docs)]
 
 mod field;
 mod locate;
@@ -30,6 +31,7 @@ pub const DEFAULT_GROWTH: f64 = 1.6;
 pub struct Ddg {
     /// Input points first (same ids as the front handed in), then new ones.
     pub points: Vec<P3>,
+    /// Point ids of each tet, as the front made them.
     pub tets: Vec<[u32; 4]>,
     /// `neigh[4t+f]` = `4t'+f'` or `u32::MAX` (from the front).
     pub neigh: Vec<u32>,
@@ -41,10 +43,13 @@ pub struct Ddg {
     pub seconds: f64,
 }
 
+/// Why the DDG could not be built.
 #[derive(Debug, thiserror::Error)]
 pub enum DdgError {
+    /// The front could not close it.
     #[error("{0}")]
     Front(#[from] FrontError),
+    /// Its size field could not be built.
     #[error("its size field: {0}")]
     Size(#[from] parafront_size::SizeError),
 }
@@ -160,9 +165,11 @@ pub fn face_neighbours(tets: &[[u32; 4]]) -> Result<Vec<u32>, SharedFace> {
 }
 
 impl Ddg {
+    /// The corners of tet `t`.
     pub fn tet_points(&self, t: usize) -> [P3; 4] {
         self.tets[t].map(|p| self.points[p as usize])
     }
+    /// The centroid of tet `t`.
     pub fn centroid(&self, t: usize) -> P3 {
         let p = self.tet_points(t);
         let mut c = [0.0; 3];
@@ -206,13 +213,7 @@ mod tests {
         let s = generate::icosphere([0.0; 3], 1.0, 3);
         let faces: Vec<[u32; 3]> = s.tris.iter().map(|t| [t[0], t[2], t[1]]).collect();
         let h = s.mean_edge_lengths();
-        let d = build(
-            s.points.clone(),
-            h,
-            faces,
-            DEFAULT_GROWTH,
-        )
-        .unwrap();
+        let d = build(s.points.clone(), h, faces, DEFAULT_GROWTH).unwrap();
         let n_new = d.points.len() - d.n_input;
         // §5: about as many extra points as surface points, or fewer.
         assert!(

@@ -93,6 +93,7 @@ pub enum Partition {
 }
 
 impl Partition {
+    /// Its name on the command line and in reports.
     pub fn name(self) -> &'static str {
         match self {
             Partition::Rcb => "rcb",

@@ -23,6 +23,7 @@ pub struct DdgBuildStats {
     /// Tets made in each parallel pass, then in the serial pass (tets
     /// peeled later are still counted where they were made).
     pub pass_tets: Vec<usize>,
+    /// Wall seconds of each pass, in the same order.
     pub pass_seconds: Vec<f64>,
     /// The size field (the surface sizes grown by `c - 1` per unit length).
     pub field_seconds: f64,

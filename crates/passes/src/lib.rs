@@ -8,6 +8,7 @@
 //! this module and only ever touched by the closure of its own part); parts
 //! see each other's data only through the messages of a [`Comm`].
 #![forbid(unsafe_code)]
+#![warn(missing_docs)]
 
 mod ddg_build;
 mod pass;
@@ -85,22 +86,39 @@ impl Default for ParOptions {
     }
 }
 
+/// Why the parallel mesher gave up on a region.
 #[derive(Debug, thiserror::Error)]
 pub enum PassError {
+    /// The DDG could not be built (§5).
     #[error("domain-defining grid: {0}")]
     Ddg(#[from] ddg::DdgError),
+    /// A part's front failed in one of the passes (§7).
     #[error("pass {pass}, part {part}: {source}")]
     Pass {
+        /// The pass, 1 to 4.
         pass: u8,
+        /// The part.
         part: usize,
+        /// Why its front failed.
         source: FrontError,
     },
-    /// Two points of the parts, with different global ids, at one place.
+    /// Two points of the parts, with different global ids, at one place
+    /// (redistribution, §8).
     #[error("redistribution: points {a} and {b} are both at {at:?}")]
-    Coincident { a: u32, b: u32, at: P3 },
-    /// A global point id that no part's tets use.
+    Coincident {
+        /// One global id.
+        a: u32,
+        /// The other.
+        b: u32,
+        /// Where both are.
+        at: P3,
+    },
+    /// A global point id that no part's tets use (redistribution, §8).
     #[error("redistribution: point {point} is in no tet of any part")]
-    Unused { point: u32 },
+    Unused {
+        /// The global id.
+        point: u32,
+    },
     /// The DDG's passes left a face in more than two tets.
     #[error("the DDG built in parallel: {0}")]
     DdgMerge(#[source] ddg::SharedFace),
@@ -110,14 +128,20 @@ pub enum PassError {
         "passes 1 to 3 left {:.0} % of the volume to the serial pass 4 (a thin part: the walls between parts cross most of it)",
         100.0 * left
     )]
-    Unsuited { left: f64 },
+    Unsuited {
+        /// The share of the volume left.
+        left: f64,
+    },
     /// The region is a thin plate before any pass runs (its volume over
     /// its area is under [`THIN_DEPTH`] mean surface edges): every such
     /// part of the corpus left 31-93 % to pass 4, after seconds to minutes.
     #[error(
         "a thin part, {depth:.2} surface edges deep (volume over area): the walls between parts would cross most of it"
     )]
-    Thin { depth: f64 },
+    Thin {
+        /// Volume over area, in mean surface edges.
+        depth: f64,
+    },
 }
 
 /// Depth, in mean surface edges, under which a region skips the passes
@@ -129,20 +153,29 @@ pub const THIN_DEPTH: f64 = 0.5;
 /// What the passes did, for the summary and the benchmark table.
 #[derive(Clone, Debug, Default)]
 pub struct ParStats {
+    /// Parts (the paper's nproc).
     pub parts: usize,
+    /// Tets of the DDG (§5).
     pub ddg_tets: usize,
+    /// Points of the DDG.
     pub ddg_points: usize,
+    /// Of which on the surface.
     pub ddg_surface_points: usize,
+    /// Its growth factor `c_i`.
     pub ddg_growth: f64,
+    /// Wall seconds of the DDG (a failed try of its passes included).
     pub ddg_seconds: f64,
     /// CPU seconds (all threads) of the DDG and of the partition, where
     /// the system tells ([`process_cpu_seconds`]; 0 elsewhere): on a
     /// shared machine their share of a run's CPU time is steadier than
     /// their share of its wall time.
     pub ddg_cpu_seconds: f64,
+    /// See `ddg_cpu_seconds`.
     pub partition_cpu_seconds: f64,
     /// With a DDG built by passes: what each pass made.
     pub ddg_build: Option<DdgBuildStats>,
+    /// Wall seconds of the partition (§6): weights, split, shifts and the
+    /// crossing partitions.
     pub partition_seconds: f64,
     /// Of which the split itself (RCB or METIS).
     pub split_seconds: f64,
@@ -150,14 +183,18 @@ pub struct ParStats {
     /// expected on them, and the face-connected pieces of the most broken
     /// part (1: every part connected).
     pub partition: ddg::Partition,
+    /// See `partition`.
     pub cut_faces: usize,
+    /// See `partition`.
     pub cut_fine_faces: f64,
+    /// See `partition`.
     pub max_components: usize,
     /// Max over mean of the predicted (DDG weight) load.
     pub predicted_imbalance: f64,
     /// Max over mean of the tets each part made in pass 1 to 3, and of the
     /// tets each part holds after redistribution.
     pub made_imbalance: f64,
+    /// See `made_imbalance`.
     pub held_imbalance: f64,
     /// Tets of passes 1 to 3 removed to give pass 4 room.
     pub peeled_tets: usize,
@@ -172,6 +209,7 @@ pub struct ParStats {
     pub crossing_passes: usize,
     /// Parts off the surface that pass 1 started from a seed tet.
     pub seeds: usize,
+    /// Wall seconds of the redistribution (§8).
     pub redistribute_seconds: f64,
 }
 
@@ -214,7 +252,9 @@ pub struct ParOutput {
     pub tets: Vec<[u32; 4]>,
     /// Pass (1 to 4) that made each tet.
     pub tet_pass: Vec<u8>,
+    /// The partitioned mesh, one piece per part.
     pub pieces: Vec<Piece>,
+    /// What the passes did.
     pub stats: ParStats,
 }
 

@@ -13,6 +13,7 @@ use rustc_hash::FxHashMap;
 /// One part of the partitioned mesh.
 #[derive(Clone, Debug, Default)]
 pub struct Piece {
+    /// The points its tets use.
     pub points: Vec<P3>,
     /// Global point id (the merged mesh's numbering).
     pub gid: Vec<u32>,
@@ -21,7 +22,9 @@ pub struct Piece {
     pub owner: Vec<u32>,
     /// Local point ids.
     pub tets: Vec<[u32; 4]>,
+    /// Global tet id (by part, then local order).
     pub tet_gid: Vec<u32>,
+    /// Pass (1 to 4) that made each tet.
     pub tet_pass: Vec<u8>,
     /// Parts sharing points with this one, ascending.
     pub neighbours: Vec<u32>,

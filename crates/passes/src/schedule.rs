@@ -151,10 +151,9 @@ impl<C: Comm> Passes<'_, C> {
 
     /// Whether the front left would make pass 4 large.
     fn crossing_wanted(&self, parts: &[Part], st: &ParStats) -> bool {
-        let left = self.comm.all_reduce(
-            parts.iter().map(|p| p.front.len()).collect(),
-            |a, b| a + b,
-        );
+        let left = self
+            .comm
+            .all_reduce(parts.iter().map(|p| p.front.len()).collect(), |a, b| a + b);
         let made: usize = st.pass_tets.iter().sum();
         (left as f64) >= CROSSING_FROM * made as f64
     }

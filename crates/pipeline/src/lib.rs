@@ -3,6 +3,7 @@
 //! passes, redistribution, improvement) slot in between the front and the
 //! check. The CLI is a thin layer over [`mesh_surface`].
 #![forbid(unsafe_code)]
+#![warn(missing_docs)]
 
 mod lattice;
 mod regions;
@@ -164,7 +165,9 @@ pub enum LatticeMode {
     /// the tets for 0.09 s).
     #[default]
     Auto,
+    /// Always.
     On,
+    /// Never.
     Off,
 }
 
@@ -180,30 +183,57 @@ impl std::str::FromStr for LatticeMode {
     }
 }
 
+/// Why [`mesh_surface`] made no mesh; each names the region, stage or
+/// element at fault.
 #[derive(Debug, thiserror::Error)]
 pub enum MeshError {
+    /// The surface failed validation (AF5): its report.
     #[error("the surface is not valid for meshing:\n{0}")]
     InvalidSurface(Box<Report>),
+    /// The size field could not be built (AG1).
     #[error("size field: {0}")]
     Size(#[from] SizeError),
+    /// The serial front failed on a region (§4).
     #[error("region {region}: {source}")]
-    Front { region: usize, source: FrontError },
+    Front {
+        /// The region (as in the mesh).
+        region: usize,
+        /// Why the front failed.
+        source: FrontError,
+    },
+    /// The parallel mesher failed on a region, where the serial front
+    /// cannot take over (§5 to §8).
     #[error("region {region}: {source}")]
-    Parallel { region: usize, source: PassError },
+    Parallel {
+        /// The region (as in the mesh).
+        region: usize,
+        /// Why the passes failed.
+        source: PassError,
+    },
+    /// The mesh failed its final check.
     #[error("the generated mesh failed its check (this is a bug in parafront): {0}")]
     Check(#[from] CheckError),
-    /// Improvement found the front's tets not face-adjacent.
+    /// Improvement (§9) found the front's tets not face-adjacent.
     #[error("mesh improvement: {source}")]
-    Improve { source: TopoError },
+    Improve {
+        /// What is wrong with the tets.
+        source: TopoError,
+    },
     /// The final mesh's tets are not face-adjacent.
     #[error("the generated mesh failed its check (this is a bug in parafront): {source}")]
-    Adjacency { source: TopoError },
+    Adjacency {
+        /// What is wrong with the tets.
+        source: TopoError,
+    },
     /// A tet whose volume is positive exactly but not in floating point.
     #[error(
         "tet {tet} is positive only under exact arithmetic (its floating-point volume is not positive); \
          the front does not yet avoid such slivers"
     )]
-    FloatVolume { tet: usize },
+    FloatVolume {
+        /// The tet.
+        tet: usize,
+    },
 }
 
 /// Mesh the volume bounded by `s`. The result keeps the surface triangle
