@@ -1,5 +1,7 @@
 //! `parafront`: the command line. A thin layer: each subcommand parses its
 //! flags into the library's option structs and calls one function.
+// Not forbid: resetting SIGPIPE (in `main`) needs one unsafe call.
+#![deny(unsafe_code)]
 mod parallel;
 mod plot;
 mod surface_cmds;
@@ -7,7 +9,7 @@ mod surface_cmds;
 use clap::{Args, Parser, Subcommand};
 use parafront_io::{read_mesh, write_mesh, MshVersion, WriteOptions};
 use parafront_mesh::QualityReport;
-use parafront_pipeline::{mesh_surface, MeshError, MeshOptions, Summary};
+use parafront_pipeline::{mesh_surface, MeshError, MeshOptions, Stage, Summary};
 use parafront_surface::read::read_surface;
 use parafront_surface::validate::validate;
 use parafront_surface::Surface;
@@ -230,6 +232,7 @@ fn main() -> ExitCode {
     // panicked; the default action ends the process quietly, as for any
     // Unix tool. Meshes go to files (written aside, then renamed), never
     // to a pipe.
+    #[allow(unsafe_code)]
     unsafe {
         libc::signal(libc::SIGPIPE, libc::SIG_DFL);
     }
@@ -416,7 +419,7 @@ fn run_mesh(s: &Surface, name: &str, out: &Path, a: &MeshArgs, w: &WriteArgs) ->
     };
     let t0 = Instant::now();
     write_mesh(out, &mesh, &wopts)?;
-    sum.stages.push(("write", t0.elapsed().as_secs_f64()));
+    sum.push(Stage::Write, t0.elapsed().as_secs_f64());
     print_summary(&sum);
     parallel::print_parallel(&sum);
     println!("wrote {}", out.display());
@@ -517,7 +520,7 @@ impl ProgressLine {
 }
 
 fn print_summary(sum: &Summary) {
-    let front = sum.seconds("front");
+    let front = sum.seconds(Stage::Front);
     println!(
         "{} tets, {} points, {} region{}",
         sum.tets,

@@ -2,7 +2,7 @@
 use crate::Fail;
 use parafront_io::{write_pvtu, Field, FieldData, Piece, WriteOptions};
 use parafront_mesh::{PointId, TetMesh};
-use parafront_pipeline::Summary;
+use parafront_pipeline::{Stage, Summary};
 use std::path::Path;
 
 /// Per-region lines: DDG, imbalance, tets per pass.
@@ -10,8 +10,10 @@ pub fn print_parallel(sum: &Summary) {
     for (r, st) in sum.parallel.iter().enumerate() {
         let total: usize = st.pass_tets.iter().sum();
         let share = |n: usize| 100.0 * n as f64 / total.max(1) as f64;
+        // The DDG's sizes are always the graded field: §5's growth per face
+        // got stuck on real surfaces (parafront_ddg::build).
         println!(
-            "region {}: {} parts; DDG {} tets, {} points ({} on the surface, {} new), growth {}{}, {:.3} s",
+            "region {}: {} parts; DDG {} tets, {} points ({} on the surface, {} new), growth {} (graded field), {:.3} s",
             r + 1,
             st.parts,
             st.ddg_tets,
@@ -19,7 +21,6 @@ pub fn print_parallel(sum: &Summary) {
             st.ddg_surface_points,
             st.ddg_points - st.ddg_surface_points,
             st.ddg_growth,
-            if st.ddg_graded { " (graded field)" } else { " (per face)" },
             st.ddg_seconds
         );
         println!(
@@ -254,9 +255,9 @@ pub fn run_bench(
                 println!(
                 "{:>5} {:>5} {:>5} {:>9} {:>9.2} {:>11.0} {:>11.0} | {:>7.2} {:>7.2} {:>7.2} {:>7.2} {:>7.2} {:>7.2} | {:>6.2} {:>6.2} {:>6.2} {:>6.2} | {:>6.3} {:>6.3} {:>8.2} | {:>5} {:>6} {:>8.0} {:>4} {:>7.3} | {:>8.2} {:>6.2} {:>6.2}",
                 p, nprol, cores, n, secs, n as f64 / secs, n as f64 / secs / cores as f64,
-                sum.seconds("ddg") + 0.0, sum.seconds("partition") + 0.0,
-                if p > 1 { sum.seconds("pass 1") } else { sum.seconds("front") } + 0.0,
-                sum.seconds("pass 2") + 0.0, sum.seconds("pass 3") + 0.0, sum.seconds("pass 4") + 0.0,
+                sum.seconds(Stage::Ddg) + 0.0, sum.seconds(Stage::Partition) + 0.0,
+                if p > 1 { sum.seconds(Stage::Pass1) } else { sum.seconds(Stage::Front) } + 0.0,
+                sum.seconds(Stage::Pass2) + 0.0, sum.seconds(Stage::Pass3) + 0.0, sum.seconds(Stage::Pass4) + 0.0,
                 share(0), share(1), share(2), share(3),
                 st.map_or(1.0, |x| x.predicted_imbalance), st.map_or(1.0, |x| x.held_imbalance),
                 crit,
@@ -266,7 +267,7 @@ pub fn run_bench(
                 st.map_or(1, |x| x.max_components),
                 st.map_or(0.0, |x| x.split_seconds),
                 cpu,
-                100.0 * (sum.seconds("ddg") + sum.seconds("partition")) / secs + 0.0,
+                100.0 * (sum.seconds(Stage::Ddg) + sum.seconds(Stage::Partition)) / secs + 0.0,
                 if cpu > 0.0 { 100.0 * ddg_cpu / cpu + 0.0 } else { 0.0 }
             );
                 for (r, e) in &sum.serial_fallback {

@@ -68,6 +68,8 @@ impl GradedField {
         GradedField::new(seeds, slope)
     }
 
+    /// The size at `x`: the least seed size grown to it (+inf without
+    /// seeds).
     pub fn size(&self, x: P3) -> f64 {
         if self.nodes.is_empty() {
             return f64::INFINITY;

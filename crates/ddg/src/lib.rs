@@ -4,6 +4,7 @@
 //! (§6, step 2), the shifted partitions of passes 2 and 3 and the region
 //! filter of one part (§7).
 #![forbid(unsafe_code)]
+#![warn(missing_docs)]
 
 mod field;
 mod locate;
@@ -30,6 +31,7 @@ pub const DEFAULT_GROWTH: f64 = 1.6;
 pub struct Ddg {
     /// Input points first (same ids as the front handed in), then new ones.
     pub points: Vec<P3>,
+    /// Point ids of each tet, as the front made them.
     pub tets: Vec<[u32; 4]>,
     /// `neigh[4t+f]` = `4t'+f'` or `u32::MAX` (from the front).
     pub neigh: Vec<u32>,
@@ -37,66 +39,35 @@ pub struct Ddg {
     pub n_input: usize,
     /// The growth factor.
     pub growth: f64,
-    pub mode: DdgMode,
+    /// Wall seconds of the build.
     pub seconds: f64,
 }
 
+/// Why the DDG could not be built.
 #[derive(Debug, thiserror::Error)]
 pub enum DdgError {
+    /// The front could not close it.
     #[error("{0}")]
     Front(#[from] FrontError),
+    /// Its size field could not be built.
     #[error("its size field: {0}")]
     Size(#[from] parafront_size::SizeError),
 }
 
-/// How the DDG's sizes are set.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub enum DdgMode {
-    /// §5 as written: sizes multiplied by `c` per face removed. The front
-    /// gets stuck under it on every real surface tried so far (sphere_1e5:
-    /// 2664 faces after 1.8 s; sphere_1e6: 6330 after 7.1 s), and with
-    /// recovery it takes longer and still fails; so it is not the default.
-    Growth,
-    /// The same growth as a field: the surface size grown linearly by
-    /// `c - 1` per unit distance (what `c` per layer amounts to). The front
-    /// closes it as reliably as a fine mesh.
-    #[default]
-    Graded,
-}
-
-/// Builds the DDG of one closed front (§5): the scalar front with its size
-/// overridden by the growth factor `c`, by the rule `mode` names.
+/// Builds the DDG of one closed front (§5): the scalar front with its
+/// sizes grown from the surface by the growth factor `c`, as a field
+/// ([`graded_field`]). §5 as written multiplies the sizes by `c` per face
+/// removed instead; the front got stuck under that on every real surface
+/// tried (sphere_1e5: 2664 faces left after 1.8 s), and closes the field
+/// as reliably as a fine mesh.
 pub fn build(
     points: Vec<P3>,
     point_size: Vec<f64>,
     faces: Vec<[u32; 3]>,
     c: f64,
-    mode: DdgMode,
 ) -> Result<Ddg, DdgError> {
     let t0 = Instant::now();
     let n_input = points.len();
-    let done = |r: parafront_front::FrontResult| Ddg {
-        points: r.points,
-        tets: r.tets,
-        neigh: r.neigh,
-        n_input,
-        growth: c,
-        mode,
-        seconds: t0.elapsed().as_secs_f64(),
-    };
-    if mode == DdgMode::Growth {
-        let r = advance(
-            FrontInput {
-                points,
-                point_size,
-                faces,
-            },
-            SizeMode::Growth(c),
-            &Everywhere,
-            &FrontOptions::default(),
-        )?;
-        return Ok(done(r));
-    }
     let field = graded_field(&points, &faces, c)?;
     let r = advance(
         FrontInput {
@@ -108,10 +79,17 @@ pub fn build(
         &Everywhere,
         &FrontOptions::default(),
     )?;
-    Ok(done(r))
+    Ok(Ddg {
+        points: r.points,
+        tets: r.tets,
+        neigh: r.neigh,
+        n_input,
+        growth: c,
+        seconds: t0.elapsed().as_secs_f64(),
+    })
 }
 
-/// The sizes of [`DdgMode::Graded`]: the surface sizes of the closed
+/// The DDG's sizes ([`build`]): the surface sizes of the closed
 /// front `faces` (the mean length of each point's edges) grown by `c - 1`
 /// per unit distance ([`GradedField`]).
 pub fn graded_field(
@@ -123,11 +101,21 @@ pub fn graded_field(
     Ok(move |p: P3| f.size(p))
 }
 
+/// A face that more than two tets share ([`face_neighbours`]).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("face {face:?} is shared by {tets} tets")]
+pub struct SharedFace {
+    /// The face's points, ascending.
+    pub face: [u32; 3],
+    /// How many tets have it.
+    pub tets: usize,
+}
+
 /// Face neighbours of `tets` in the front's convention: `neigh[4t+f]` is
 /// `4t'+f'` for the tet across face `f` (the face opposite corner `f`),
 /// `u32::MAX` on the boundary. Fails on a face shared by more than two
 /// tets.
-pub fn face_neighbours(tets: &[[u32; 4]]) -> Result<Vec<u32>, String> {
+pub fn face_neighbours(tets: &[[u32; 4]]) -> Result<Vec<u32>, SharedFace> {
     use rayon::prelude::*;
     let mut faces: Vec<([u32; 3], u32)> = tets
         .par_iter()
@@ -164,7 +152,12 @@ pub fn face_neighbours(tets: &[[u32; 4]]) -> Result<Vec<u32>, String> {
                 neigh[a as usize] = b;
                 neigh[b as usize] = a;
             }
-            n => return Err(format!("face {:?} is shared by {n} tets", faces[i].0)),
+            n => {
+                return Err(SharedFace {
+                    face: faces[i].0,
+                    tets: n,
+                })
+            }
         }
         i = j;
     }
@@ -172,9 +165,11 @@ pub fn face_neighbours(tets: &[[u32; 4]]) -> Result<Vec<u32>, String> {
 }
 
 impl Ddg {
+    /// The corners of tet `t`.
     pub fn tet_points(&self, t: usize) -> [P3; 4] {
         self.tets[t].map(|p| self.points[p as usize])
     }
+    /// The centroid of tet `t`.
     pub fn centroid(&self, t: usize) -> P3 {
         let p = self.tet_points(t);
         let mut c = [0.0; 3];
@@ -218,14 +213,7 @@ mod tests {
         let s = generate::icosphere([0.0; 3], 1.0, 3);
         let faces: Vec<[u32; 3]> = s.tris.iter().map(|t| [t[0], t[2], t[1]]).collect();
         let h = s.mean_edge_lengths();
-        let d = build(
-            s.points.clone(),
-            h,
-            faces,
-            DEFAULT_GROWTH,
-            DdgMode::default(),
-        )
-        .unwrap();
+        let d = build(s.points.clone(), h, faces, DEFAULT_GROWTH).unwrap();
         let n_new = d.points.len() - d.n_input;
         // §5: about as many extra points as surface points, or fewer.
         assert!(

@@ -144,6 +144,7 @@ pub struct Locator {
 }
 
 impl Locator {
+    /// Bins the tets of `d`.
     pub fn new(d: &Ddg) -> Locator {
         let tets: Vec<[P3; 4]> = (0..d.tets.len()).map(|t| d.tet_points(t)).collect();
         let boxes = tets.iter().map(|p| Aabb::from_points(p.iter())).collect();
@@ -285,6 +286,7 @@ pub struct Interfaces {
 }
 
 impl Interfaces {
+    /// The walls of partition `part` (DDG tet -> part) of `d`.
     pub fn new(d: &Ddg, part: &[u32]) -> Interfaces {
         let mut faces = Vec::new();
         let mut sides = Vec::new();
@@ -334,15 +336,20 @@ impl Interfaces {
 /// the part's DDG tets and off its boundary (the conservative assignment),
 /// an edge must not cross a wall of the part.
 pub struct PartFilter<'a> {
+    /// Locates points in the DDG.
     pub loc: &'a Locator,
+    /// The walls between parts.
     pub walls: &'a Interfaces,
+    /// The partition (DDG tet -> part).
     pub part: &'a [u32],
+    /// The part.
     pub k: u32,
     /// The DDG tet of the last point located alone ([`Locator::owner_near`]).
     pub hint: AtomicU32,
 }
 
 impl<'a> PartFilter<'a> {
+    /// The filter of part `k` of partition `part`, with its walls.
     pub fn new(loc: &'a Locator, walls: &'a Interfaces, part: &'a [u32], k: u32) -> Self {
         PartFilter {
             loc,

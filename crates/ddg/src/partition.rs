@@ -93,6 +93,7 @@ pub enum Partition {
 }
 
 impl Partition {
+    /// Its name on the command line and in reports.
     pub fn name(self) -> &'static str {
         match self {
             Partition::Rcb => "rcb",
@@ -484,7 +485,6 @@ mod tests {
             s.mean_edge_lengths(),
             faces,
             crate::DEFAULT_GROWTH,
-            crate::DdgMode::default(),
         )
         .unwrap()
     }

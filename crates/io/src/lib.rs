@@ -15,6 +15,7 @@
 //! named physical groups (from 1: tags shifted by 1 when one is 0) and
 //! Medit refs.
 #![forbid(unsafe_code)]
+#![warn(missing_docs)]
 
 mod atomic;
 mod medit;
@@ -36,23 +37,40 @@ use std::path::{Path, PathBuf};
 /// Errors of reading and writing mesh files; each names the file.
 #[derive(Debug, thiserror::Error)]
 pub enum IoError {
+    /// The file could not be opened, read or written.
     #[error("{}: {source}", path.display())]
     Io {
+        /// The file.
         path: PathBuf,
+        /// What the system said.
         #[source]
         source: std::io::Error,
     },
+    /// The file's extension names no mesh format.
     #[error("{}: unknown mesh format (expected .vtu, .msh or .mesh)", path.display())]
-    UnknownFormat { path: PathBuf },
+    UnknownFormat {
+        /// The file.
+        path: PathBuf,
+    },
     /// The file is malformed; `msg` says where (line, element, array).
     #[error("{}: {msg}", path.display())]
-    Parse { path: PathBuf, msg: String },
+    Parse {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong, and where.
+        msg: String,
+    },
     /// A `.msh` or `.mesh` file the surface crate's parser rejected.
     #[error(transparent)]
     Read(#[from] parafront_surface::read::ReadError),
     /// The data handed to a writer cannot be written as asked.
     #[error("cannot write {}: {msg}", path.display())]
-    BadInput { path: PathBuf, msg: String },
+    BadInput {
+        /// The file.
+        path: PathBuf,
+        /// What cannot be written.
+        msg: String,
+    },
 }
 
 /// Mesh file formats, chosen by [`Format::from_path`].

@@ -26,8 +26,11 @@ const BLOCK: usize = 1 << 15;
 /// The values of an extra array, `ncomp` scalars per point or cell.
 #[derive(Clone, Copy, Debug)]
 pub enum FieldData<'a> {
+    /// `Float64` values.
     F64(&'a [f64]),
+    /// `Int32` values.
     I32(&'a [i32]),
+    /// `Int64` values.
     I64(&'a [i64]),
     /// For markers such as `vtkGhostType`.
     U8(&'a [u8]),
@@ -50,12 +53,16 @@ impl FieldData<'_> {
 /// `GlobalCellIds` are declared as VTK global ids.
 #[derive(Clone, Copy, Debug)]
 pub struct Field<'a> {
+    /// The array's name in the file.
     pub name: &'a str,
+    /// Components per point or cell.
     pub ncomp: usize,
+    /// The values, `ncomp` per point or cell in order.
     pub data: FieldData<'a>,
 }
 
 impl<'a> Field<'a> {
+    /// One value per point or cell.
     pub fn scalar(name: &'a str, data: FieldData<'a>) -> Self {
         Field {
             name,
@@ -68,12 +75,16 @@ impl<'a> Field<'a> {
 /// One mesh with its extra arrays: a `.vtu` file or a part of a `.pvtu`.
 #[derive(Clone, Debug)]
 pub struct Piece<'a> {
+    /// The mesh.
     pub mesh: &'a TetMesh,
+    /// Its arrays per point.
     pub point_fields: Vec<Field<'a>>,
+    /// Its arrays per cell.
     pub cell_fields: Vec<Field<'a>>,
 }
 
 impl<'a> Piece<'a> {
+    /// The mesh alone, without extra arrays.
     pub fn new(mesh: &'a TetMesh) -> Self {
         Piece {
             mesh,

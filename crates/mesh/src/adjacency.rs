@@ -10,31 +10,45 @@ use thiserror::Error;
 /// Why the tets do not form a valid face adjacency.
 #[derive(Debug, Clone, PartialEq, Eq, Error)]
 pub enum TopoError {
+    /// More tets than face references `4t+f` can number.
     #[error("{n} tets: too many for u32 face references (at most {max})", max = MAX_TETS)]
-    TooManyTets { n: usize },
+    TooManyTets {
+        /// The tets.
+        n: usize,
+    },
+    /// A tet naming one point twice.
     #[error("tet {tet} lists point {point} twice: {verts:?}")]
     RepeatedVertex {
+        /// The tet.
         tet: TetId,
+        /// The point it repeats.
         point: PointId,
+        /// Its points.
         verts: [PointId; 4],
     },
+    /// A face in three or more tets.
     #[error(
         "face ({}, {}, {}) belongs to {} tets {:?}; a face may belong to at most two{}",
         face[0], face[1], face[2], tets.len(), tets.iter().map(|t| t.0).collect::<Vec<_>>(),
         more_msg(*more)
     )]
     FaceInManyTets {
+        /// The face's points.
         face: [PointId; 3],
+        /// The tets that have it.
         tets: Vec<TetId>,
         /// Other bad faces found besides this one.
         more: usize,
     },
+    /// Two tets on the same side of their shared face.
     #[error(
         "tets {} and {} both see face ({}, {}, {}) from the same side (they overlap, or one is inverted){}",
         tets[0], tets[1], face[0], face[1], face[2], more_msg(*more)
     )]
     FaceSameSide {
+        /// The face's points.
         face: [PointId; 3],
+        /// The two tets.
         tets: [TetId; 2],
         /// Other bad faces found besides this one.
         more: usize,

@@ -8,12 +8,11 @@
 //! picture of a broken mesh.
 use crate::faces::*;
 use crate::ids::*;
+use crate::problem::*;
 use crate::tetmesh::TetMesh;
-use parafront_geom::{cross, dot, orient3d, sub, tet_volume6, Aabb, P3};
+use parafront_geom::{cross, dot, orient3d, sub, tet_volume6, Aabb};
 use rayon::prelude::*;
-use std::fmt;
 use std::sync::atomic::{AtomicBool, Ordering::Relaxed};
-use thiserror::Error;
 
 /// How many problems of each kind are kept with their details.
 pub const SAMPLES: usize = 5;
@@ -24,9 +23,11 @@ pub const VOLUME_RTOL: f64 = 1e-9;
 /// What a successful check measured.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct CheckStats {
+    /// Points of the mesh.
     pub n_points: usize,
     /// Points that no tet uses.
     pub n_unused_points: usize,
+    /// Tets of the mesh.
     pub n_tets: usize,
     /// Distinct region ids (1 when `region` is empty and there are tets).
     pub n_regions: usize,
@@ -45,230 +46,6 @@ pub struct CheckStats {
     /// Volume enclosed by the input triangles (`check_against_surface` only).
     pub surface_volume: Option<f64>,
 }
-
-/// The kinds of [`MeshProblem`], for counting and matching.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub enum ProblemKind {
-    ArrayLength,
-    NonFinitePoint,
-    PointOutOfRange,
-    RepeatedVertex,
-    NotPositive,
-    FaceInManyTets,
-    FaceSameSide,
-    NeighWrong,
-    BadInputTriangle,
-    MissingBoundaryFace,
-    ExtraBoundaryFace,
-    FlippedBoundaryFace,
-    DuplicateInputTriangle,
-    VolumeMismatch,
-}
-const NK: usize = ProblemKind::VolumeMismatch as usize + 1;
-
-struct Pt(P3);
-impl fmt::Display for Pt {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "({}, {}, {})", self.0[0], self.0[1], self.0[2])
-    }
-}
-struct Pts<'a>(&'a [P3]);
-impl fmt::Display for Pts<'_> {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        for (i, p) in self.0.iter().enumerate() {
-            if i > 0 {
-                write!(f, " ")?;
-            }
-            write!(f, "{}", Pt(*p))?;
-        }
-        Ok(())
-    }
-}
-fn ids<T: fmt::Display>(v: &[T]) -> String {
-    v.iter()
-        .map(|x| x.to_string())
-        .collect::<Vec<_>>()
-        .join(", ")
-}
-
-/// One thing wrong with a mesh, with the ids and coordinates involved.
-#[derive(Clone, Debug, PartialEq, Error)]
-pub enum MeshProblem {
-    #[error("array {name} has length {len}, expected {expected}")]
-    ArrayLength {
-        name: &'static str,
-        len: usize,
-        expected: String,
-    },
-    #[error("point {point} has a non-finite coordinate {}", Pt(*coords))]
-    NonFinitePoint { point: PointId, coords: P3 },
-    #[error("tet {tet} uses point {point}, but there are only {n_points} points")]
-    PointOutOfRange {
-        tet: TetId,
-        point: PointId,
-        n_points: usize,
-    },
-    #[error("tet {tet} repeats a vertex: ({})", ids(verts))]
-    RepeatedVertex { tet: TetId, verts: [PointId; 4] },
-    #[error(
-        "tet {tet} ({}) is {} (6*volume = {volume6:e}): {}",
-        ids(verts), if *flat { "flat" } else { "inverted" }, Pts(coords)
-    )]
-    NotPositive {
-        tet: TetId,
-        verts: [PointId; 4],
-        coords: [P3; 4],
-        /// Floating-point six times volume (the sign decision is exact).
-        volume6: f64,
-        /// Zero volume exactly, rather than negative.
-        flat: bool,
-    },
-    #[error("face ({}) belongs to {} tets: {}", ids(face), tets.len(), ids(tets))]
-    FaceInManyTets {
-        face: [PointId; 3],
-        tets: Vec<TetId>,
-    },
-    #[error(
-        "tets {} and {} both see face ({}) from the same side (overlap or inversion)",
-        tets[0], tets[1], ids(face)
-    )]
-    FaceSameSide {
-        face: [PointId; 3],
-        tets: [TetId; 2],
-    },
-    #[error(
-        "neigh of face {} of tet {} ({}) is {}, expected {}",
-        face.local(), face.tet(), ids(verts), fref(*found), fref(*expected)
-    )]
-    NeighWrong {
-        face: FaceRef,
-        verts: [PointId; 3],
-        found: FaceRef,
-        expected: FaceRef,
-    },
-    #[error("input triangle {tri} ({}) {why}", ids(verts))]
-    BadInputTriangle {
-        tri: usize,
-        verts: [u32; 3],
-        why: &'static str,
-    },
-    #[error(
-        "input triangle {tri} ({}) is not a mesh boundary face: {why}; at {}",
-        ids(verts),
-        Pts(coords)
-    )]
-    MissingBoundaryFace {
-        tri: usize,
-        verts: [u32; 3],
-        coords: [P3; 3],
-        why: String,
-    },
-    #[error(
-        "face {} of tet {} ({}) is {} but no input triangle; at {}",
-        face.local(), face.tet(), ids(verts),
-        match regions { Some(r) => format!("an interface between regions {} and {}", r[0], r[1]), None => "on the boundary".into() },
-        Pts(coords)
-    )]
-    ExtraBoundaryFace {
-        face: FaceRef,
-        verts: [PointId; 3],
-        coords: [P3; 3],
-        /// The two regions when the face lies between two tets.
-        regions: Option<[u32; 2]>,
-    },
-    #[error(
-        "input triangle {tri} ({}) is reversed: the mesh boundary face {} of tet {} is ({})",
-        ids(verts), face.local(), face.tet(), ids(mesh_verts)
-    )]
-    FlippedBoundaryFace {
-        tri: usize,
-        verts: [u32; 3],
-        face: FaceRef,
-        mesh_verts: [PointId; 3],
-    },
-    #[error(
-        "input triangles {} are the same face ({}) one time too many",
-        ids(tris),
-        ids(verts)
-    )]
-    DuplicateInputTriangle { tris: Vec<usize>, verts: [u32; 3] },
-    #[error(
-        "tet volumes sum to {mesh}, but the triangles enclose {surface} (relative difference {rel:e})"
-    )]
-    VolumeMismatch { mesh: f64, surface: f64, rel: f64 },
-}
-
-fn fref(f: FaceRef) -> String {
-    if f.is_none() {
-        "none (boundary)".into()
-    } else {
-        format!("face {} of tet {}", f.local(), f.tet())
-    }
-}
-
-impl MeshProblem {
-    pub fn kind(&self) -> ProblemKind {
-        use MeshProblem as P;
-        use ProblemKind as K;
-        match self {
-            P::ArrayLength { .. } => K::ArrayLength,
-            P::NonFinitePoint { .. } => K::NonFinitePoint,
-            P::PointOutOfRange { .. } => K::PointOutOfRange,
-            P::RepeatedVertex { .. } => K::RepeatedVertex,
-            P::NotPositive { .. } => K::NotPositive,
-            P::FaceInManyTets { .. } => K::FaceInManyTets,
-            P::FaceSameSide { .. } => K::FaceSameSide,
-            P::NeighWrong { .. } => K::NeighWrong,
-            P::BadInputTriangle { .. } => K::BadInputTriangle,
-            P::MissingBoundaryFace { .. } => K::MissingBoundaryFace,
-            P::ExtraBoundaryFace { .. } => K::ExtraBoundaryFace,
-            P::FlippedBoundaryFace { .. } => K::FlippedBoundaryFace,
-            P::DuplicateInputTriangle { .. } => K::DuplicateInputTriangle,
-            P::VolumeMismatch { .. } => K::VolumeMismatch,
-        }
-    }
-}
-
-/// A mesh that failed its check: the first few problems of each kind, and
-/// how many of each kind there were.
-#[derive(Clone, Debug, PartialEq)]
-pub struct CheckError {
-    /// Up to [`SAMPLES`] problems of each kind, in element order per kind.
-    pub problems: Vec<MeshProblem>,
-    /// Number of problems found, per kind, for kinds that occurred.
-    pub counts: Vec<(ProblemKind, usize)>,
-}
-
-impl CheckError {
-    /// How many problems of kind `k` were found.
-    pub fn count(&self, k: ProblemKind) -> usize {
-        self.counts
-            .iter()
-            .find(|c| c.0 == k)
-            .map(|c| c.1)
-            .unwrap_or(0)
-    }
-    /// The kept problems of kind `k`.
-    pub fn of_kind(&self, k: ProblemKind) -> impl Iterator<Item = &MeshProblem> {
-        self.problems.iter().filter(move |p| p.kind() == k)
-    }
-}
-
-impl fmt::Display for CheckError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let total: usize = self.counts.iter().map(|c| c.1).sum();
-        write!(f, "mesh check failed with {total} problems (")?;
-        for (i, (k, n)) in self.counts.iter().enumerate() {
-            write!(f, "{}{n} {k:?}", if i > 0 { ", " } else { "" })?;
-        }
-        write!(f, ")")?;
-        for p in &self.problems {
-            write!(f, "\n  - {p}")?;
-        }
-        Ok(())
-    }
-}
-impl std::error::Error for CheckError {}
 
 /// Problems found by one piece of parallel work; merging keeps the first
 /// `SAMPLES` of each kind in order.

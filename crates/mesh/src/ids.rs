@@ -8,10 +8,12 @@ macro_rules! id_type {
         #[repr(transparent)]
         pub struct $name(pub u32);
         impl $name {
+            /// As an array index.
             #[inline(always)]
             pub fn idx(self) -> usize {
                 self.0 as usize
             }
+            /// From an array index (below `u32::MAX`).
             #[inline(always)]
             pub fn new(i: usize) -> Self {
                 debug_assert!(i < u32::MAX as usize);
@@ -43,18 +45,22 @@ id_type!(
 pub const NO_FACE: FaceRef = FaceRef(u32::MAX);
 
 impl FaceRef {
+    /// Face `f` (0 to 3) of tet `t`.
     #[inline(always)]
     pub fn of(t: TetId, f: usize) -> FaceRef {
         FaceRef(t.0 * 4 + f as u32)
     }
+    /// The tet.
     #[inline(always)]
     pub fn tet(self) -> TetId {
         TetId(self.0 >> 2)
     }
+    /// The local face, 0 to 3 (opposite vertex `f`).
     #[inline(always)]
     pub fn local(self) -> usize {
         (self.0 & 3) as usize
     }
+    /// Whether it is [`NO_FACE`].
     #[inline(always)]
     pub fn is_none(self) -> bool {
         self == NO_FACE

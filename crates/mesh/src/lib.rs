@@ -13,17 +13,20 @@
 //! - [`quality`]: dihedral angles, radius and mean ratio, edge length vs size.
 //! - [`generate`]: structured box meshes for tests.
 #![forbid(unsafe_code)]
+#![warn(missing_docs)]
 
 mod adjacency;
 mod check;
 mod faces;
 pub mod generate;
 pub mod ids;
+mod problem;
 pub mod quality;
 mod tetmesh;
 
 pub use adjacency::{TopoError, MAX_TETS};
-pub use check::{CheckError, CheckStats, MeshProblem, ProblemKind, SAMPLES, VOLUME_RTOL};
+pub use check::{CheckStats, SAMPLES, VOLUME_RTOL};
 pub use ids::{FaceRef, PointId, TetId, NO_FACE};
+pub use problem::{CheckError, MeshProblem, ProblemKind};
 pub use quality::{QualityReport, TetQuality};
 pub use tetmesh::{TetMesh, TET_FACES};

@@ -17,8 +17,9 @@ pub const REGULAR_DIHEDRAL: f64 = 70.528_779_365_509_31;
 /// Quality of one tet.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TetQuality {
-    /// Smallest and largest dihedral angle, degrees.
+    /// Smallest dihedral angle, degrees.
     pub min_dihedral: f64,
+    /// Largest dihedral angle, degrees.
     pub max_dihedral: f64,
     /// `3 r / R` (inradius over circumradius); 1 regular, < 0 inverted.
     pub radius_ratio: f64,
@@ -71,8 +72,8 @@ pub fn radius_ratio(p: [P3; 4]) -> f64 {
 }
 
 /// `12 (3|V|)^(2/3) / sum l^2`, signed by the volume: 1 for the regular
-/// tet, 0 when flat. The one mean ratio of the workspace: the front ranks
-/// its candidates by it and the improvement (§9) optimises it.
+/// tet, 0 when flat. The improvement (§9) optimises it and the report
+/// shows it; the front ranks its candidates by it (rounded its own way).
 #[inline]
 pub fn mean_ratio(p: [P3; 4]) -> f64 {
     mean_ratio_of(tet_volume6(p[0], p[1], p[2], p[3]), edge_length2_sum(p))
@@ -101,6 +102,7 @@ pub fn edge_length2_sum(p: [P3; 4]) -> f64 {
         + dist2(p[2], p[3])
 }
 
+/// Dihedral angles, radius ratio, mean ratio and volume of the tet `p`.
 pub fn tet_quality(p: [P3; 4]) -> TetQuality {
     let d = dihedral_angles(p);
     TetQuality {
@@ -167,9 +169,13 @@ pub fn edge_size_ratios(mesh: &TetMesh, size: impl Fn(P3) -> f64 + Sync) -> Vec<
 /// Min, mean and max of a measure.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Stat {
+    /// Smallest value.
     pub min: f64,
+    /// Mean value.
     pub mean: f64,
+    /// Largest value.
     pub max: f64,
+    /// Values measured (0: the others are NaN).
     pub count: usize,
 }
 
@@ -223,12 +229,16 @@ impl StatAcc {
 /// bins, so the counts always add up to the number of values.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Histogram {
+    /// Lower end of the range.
     pub lo: f64,
+    /// Upper end of the range.
     pub hi: f64,
+    /// Values per bin.
     pub counts: Vec<u64>,
 }
 
 impl Histogram {
+    /// `bins` empty bins (at least one) over `[lo, hi]`.
     pub fn new(lo: f64, hi: f64, bins: usize) -> Histogram {
         Histogram {
             lo,
@@ -236,6 +246,7 @@ impl Histogram {
             counts: vec![0; bins.max(1)],
         }
     }
+    /// Width of one bin.
     pub fn bin_width(&self) -> f64 {
         (self.hi - self.lo) / self.counts.len() as f64
     }
@@ -243,6 +254,7 @@ impl Histogram {
     pub fn bin_lo(&self, i: usize) -> f64 {
         self.lo + i as f64 * self.bin_width()
     }
+    /// The bin `x` falls in (the end bins take what is outside).
     pub fn bin_of(&self, x: f64) -> usize {
         let n = self.counts.len();
         let b = ((x - self.lo) / self.bin_width()).floor();
@@ -254,10 +266,12 @@ impl Histogram {
             0 // negative or NaN
         }
     }
+    /// Counts `x`.
     pub fn add(&mut self, x: f64) {
         let b = self.bin_of(x);
         self.counts[b] += 1;
     }
+    /// Values counted.
     pub fn total(&self) -> u64 {
         self.counts.iter().sum()
     }
@@ -285,14 +299,19 @@ pub const SMALL_DIHEDRAL: f64 = 10.0;
 /// Mesh quality summary with histograms.
 #[derive(Clone, Debug, PartialEq)]
 pub struct QualityReport {
+    /// Tets in the mesh.
     pub n_tets: usize,
     /// Tets with non-positive floating-point volume.
     pub n_inverted: usize,
     /// Tets left out because a point id is out of range.
     pub n_skipped: usize,
+    /// Smallest dihedral angle per tet, degrees.
     pub min_dihedral: Stat,
+    /// Largest dihedral angle per tet, degrees.
     pub max_dihedral: Stat,
+    /// Radius ratio per tet.
     pub radius_ratio: Stat,
+    /// Mean ratio per tet.
     pub mean_ratio: Stat,
     /// All six dihedral angles of every tet, 1-degree bins over [0, 180].
     pub dihedral_hist: Histogram,
@@ -302,6 +321,7 @@ pub struct QualityReport {
     pub max_dihedral_hist: Histogram,
     /// 0.05 bins over [0, 1] (inverted tets in the first bin).
     pub radius_ratio_hist: Histogram,
+    /// 0.05 bins over [0, 1] (inverted tets in the first bin).
     pub mean_ratio_hist: Histogram,
     /// Share (0..1) of tets whose smallest dihedral is below 10 degrees.
     pub share_min_dihedral_below: f64,

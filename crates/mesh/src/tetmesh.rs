@@ -21,13 +21,16 @@ pub struct TetMesh {
     /// Boundary triangles (outward, i.e. as in the input surface) with their
     /// patch tags; carried through to output.
     pub bnd_tris: Vec<[PointId; 3]>,
+    /// Patch tag per boundary triangle.
     pub bnd_patch: Vec<u32>,
 }
 
 impl TetMesh {
+    /// Number of points.
     pub fn n_points(&self) -> usize {
         self.points.len()
     }
+    /// Number of tets.
     pub fn n_tets(&self) -> usize {
         self.tets.len()
     }

@@ -33,7 +33,6 @@ fn main() {
                             hs.clone(),
                             faces.clone(),
                             c,
-                            parafront_ddg::DdgMode::Graded,
                         )
                         .unwrap();
                         format!("{} tets", d.tets.len())

@@ -12,7 +12,7 @@
 //! threads.
 use crate::{parallel_pass, peel_stuck, seed_parts, serial_pass, PassError, Regions, Sizes};
 use parafront_comm::Comm;
-use parafront_ddg::{self as ddg, Ddg, DdgMode};
+use parafront_ddg::{self as ddg, Ddg};
 use parafront_front::RegionFilter;
 use parafront_geom::{cross, dist, dot, norm, sub, Aabb, P3};
 use std::time::Instant;
@@ -23,6 +23,7 @@ pub struct DdgBuildStats {
     /// Tets made in each parallel pass, then in the serial pass (tets
     /// peeled later are still counted where they were made).
     pub pass_tets: Vec<usize>,
+    /// Wall seconds of each pass, in the same order.
     pub pass_seconds: Vec<f64>,
     /// The size field (the surface sizes grown by `c - 1` per unit length).
     pub field_seconds: f64,
@@ -288,7 +289,7 @@ fn enclosed_volume(points: &[P3], faces: &[[u32; 3]]) -> f64 {
 const DDG_SERIAL_ROUNDS: [u32; 2] = [1, 12];
 
 /// Builds the DDG of the closed front `faces` (normals inward) with
-/// growth `c` (the graded sizes of [`DdgMode::Graded`]): `passes` parallel
+/// growth `c` (the graded sizes of [`ddg::build`]): `passes` parallel
 /// passes on `comm.parts()` convex cells each, then the serial pass on
 /// what they left. The sizes are the DDG's own, from the front's edges
 /// (the fine mesh's sizes do not enter).
@@ -450,8 +451,7 @@ pub(crate) fn build_ddg_at<C: Comm>(
     for t in &mut tets {
         *t = t.map(|g| map[g as usize]);
     }
-    let neigh = ddg::face_neighbours(&tets)
-        .map_err(|e| PassError::Redistribute(format!("the DDG built in parallel: {e}")))?;
+    let neigh = ddg::face_neighbours(&tets).map_err(PassError::DdgMerge)?;
     st.merge_seconds = t0.elapsed().as_secs_f64();
     Ok((
         Ddg {
@@ -460,7 +460,6 @@ pub(crate) fn build_ddg_at<C: Comm>(
             neigh,
             n_input: points.len(),
             growth: c,
-            mode: DdgMode::Graded,
             seconds: t_all.elapsed().as_secs_f64(),
         },
         st,

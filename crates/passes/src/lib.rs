@@ -8,15 +8,18 @@
 //! this module and only ever touched by the closure of its own part); parts
 //! see each other's data only through the messages of a [`Comm`].
 #![forbid(unsafe_code)]
+#![warn(missing_docs)]
 
 mod ddg_build;
 mod pass;
 mod pockets;
 mod redistribute;
+mod schedule;
 mod serial;
 
 use pass::{front_left_per_tet, parallel_pass, seed_inner_parts};
 use pockets::*;
+use schedule::{Partitions, Passes, Recorder};
 use serial::*;
 
 pub use ddg_build::{build_ddg, DdgBuildStats};
@@ -83,32 +86,62 @@ impl Default for ParOptions {
     }
 }
 
+/// Why the parallel mesher gave up on a region.
 #[derive(Debug, thiserror::Error)]
 pub enum PassError {
+    /// The DDG could not be built (§5).
     #[error("domain-defining grid: {0}")]
     Ddg(#[from] ddg::DdgError),
+    /// A part's front failed in one of the passes (§7).
     #[error("pass {pass}, part {part}: {source}")]
     Pass {
+        /// The pass, 1 to 4.
         pass: u8,
+        /// The part.
         part: usize,
+        /// Why its front failed.
         source: FrontError,
     },
-    #[error("redistribution: {0}")]
-    Redistribute(String),
+    /// Two points of the parts, with different global ids, at one place
+    /// (redistribution, §8).
+    #[error("redistribution: points {a} and {b} are both at {at:?}")]
+    Coincident {
+        /// One global id.
+        a: u32,
+        /// The other.
+        b: u32,
+        /// Where both are.
+        at: P3,
+    },
+    /// A global point id that no part's tets use (redistribution, §8).
+    #[error("redistribution: point {point} is in no tet of any part")]
+    Unused {
+        /// The global id.
+        point: u32,
+    },
+    /// The DDG's passes left a face in more than two tets.
+    #[error("the DDG built in parallel: {0}")]
+    DdgMerge(#[source] ddg::SharedFace),
     /// Passes 1 to 3 left most of the region to the serial pass 4: a thin
     /// part, whose DDG has little interior to split.
     #[error(
         "passes 1 to 3 left {:.0} % of the volume to the serial pass 4 (a thin part: the walls between parts cross most of it)",
         100.0 * left
     )]
-    Unsuited { left: f64 },
+    Unsuited {
+        /// The share of the volume left.
+        left: f64,
+    },
     /// The region is a thin plate before any pass runs (its volume over
     /// its area is under [`THIN_DEPTH`] mean surface edges): every such
     /// part of the corpus left 31-93 % to pass 4, after seconds to minutes.
     #[error(
         "a thin part, {depth:.2} surface edges deep (volume over area): the walls between parts would cross most of it"
     )]
-    Thin { depth: f64 },
+    Thin {
+        /// Volume over area, in mean surface edges.
+        depth: f64,
+    },
 }
 
 /// Depth, in mean surface edges, under which a region skips the passes
@@ -120,22 +153,29 @@ pub const THIN_DEPTH: f64 = 0.5;
 /// What the passes did, for the summary and the benchmark table.
 #[derive(Clone, Debug, Default)]
 pub struct ParStats {
+    /// Parts (the paper's nproc).
     pub parts: usize,
+    /// Tets of the DDG (§5).
     pub ddg_tets: usize,
+    /// Points of the DDG.
     pub ddg_points: usize,
+    /// Of which on the surface.
     pub ddg_surface_points: usize,
+    /// Its growth factor `c_i`.
     pub ddg_growth: f64,
-    /// The DDG used the graded field (the per-face growth got stuck).
-    pub ddg_graded: bool,
+    /// Wall seconds of the DDG (a failed try of its passes included).
     pub ddg_seconds: f64,
     /// CPU seconds (all threads) of the DDG and of the partition, where
     /// the system tells ([`process_cpu_seconds`]; 0 elsewhere): on a
     /// shared machine their share of a run's CPU time is steadier than
     /// their share of its wall time.
     pub ddg_cpu_seconds: f64,
+    /// See `ddg_cpu_seconds`.
     pub partition_cpu_seconds: f64,
     /// With a DDG built by passes: what each pass made.
     pub ddg_build: Option<DdgBuildStats>,
+    /// Wall seconds of the partition (§6): weights, split, shifts and the
+    /// crossing partitions.
     pub partition_seconds: f64,
     /// Of which the split itself (RCB or METIS).
     pub split_seconds: f64,
@@ -143,14 +183,18 @@ pub struct ParStats {
     /// expected on them, and the face-connected pieces of the most broken
     /// part (1: every part connected).
     pub partition: ddg::Partition,
+    /// See `partition`.
     pub cut_faces: usize,
+    /// See `partition`.
     pub cut_fine_faces: f64,
+    /// See `partition`.
     pub max_components: usize,
     /// Max over mean of the predicted (DDG weight) load.
     pub predicted_imbalance: f64,
     /// Max over mean of the tets each part made in pass 1 to 3, and of the
     /// tets each part holds after redistribution.
     pub made_imbalance: f64,
+    /// See `made_imbalance`.
     pub held_imbalance: f64,
     /// Tets of passes 1 to 3 removed to give pass 4 room.
     pub peeled_tets: usize,
@@ -165,6 +209,7 @@ pub struct ParStats {
     pub crossing_passes: usize,
     /// Parts off the surface that pass 1 started from a seed tet.
     pub seeds: usize,
+    /// Wall seconds of the redistribution (§8).
     pub redistribute_seconds: f64,
 }
 
@@ -207,7 +252,9 @@ pub struct ParOutput {
     pub tets: Vec<[u32; 4]>,
     /// Pass (1 to 4) that made each tet.
     pub tet_pass: Vec<u8>,
+    /// The partitioned mesh, one piece per part.
     pub pieces: Vec<Piece>,
+    /// What the passes did.
     pub stats: ParStats,
 }
 
@@ -350,216 +397,33 @@ pub fn mesh_parallel<C: Comm>(
     comm: &C,
 ) -> Result<ParOutput, PassError> {
     let np = comm.parts();
-    let mut st = ParStats {
-        parts: np,
-        ..Default::default()
-    };
     let depth = ddg_build::depth(points, faces);
     if depth < opts.thin_depth {
         return Err(PassError::Thin { depth });
     }
     // §5 step 1: the DDG (replicated: it is small).
-    let cpu0 = process_cpu_seconds();
+    let mut rec = Recorder::new(np);
     let t_ddg = Instant::now();
-    let built = if opts.ddg_passes > 0 {
-        let (c, passes, cap) = (opts.growth, opts.ddg_passes, opts.ddg_cap);
-        match ddg_build::build_ddg_at(points, faces, depth, c, passes, cap, comm) {
-            Ok((d, bs)) => {
-                st.ddg_build = Some(bs);
-                Some(d)
-            }
-            // The serial front gets another go (deterministic: the same
-            // failure on any thread count); `ddg_build` stays `None`.
-            Err(e) => {
-                if tracing::enabled!(tracing::Level::DEBUG) {
-                    tracing::debug!("the DDG's passes failed ({e}); the serial front builds it");
-                }
-                None
-            }
-        }
-    } else {
-        None
-    };
-    let d = if let Some(d) = built {
-        d
-    } else {
-        ddg::build(
-            points.to_vec(),
-            point_size.to_vec(),
-            faces.to_vec(),
-            opts.growth,
-            ddg::DdgMode::default(),
-        )
-        .map_err(PassError::Ddg)?
-    };
-    st.ddg_tets = d.tets.len();
-    st.ddg_points = d.points.len();
-    st.ddg_surface_points = d.n_input;
-    st.ddg_growth = d.growth;
-    st.ddg_graded = d.mode == ddg::DdgMode::Graded;
-    // A failed try of the passes included.
-    st.ddg_seconds = t_ddg.elapsed().as_secs_f64();
-
-    let cpu1 = process_cpu_seconds();
+    let (d, built) = the_ddg(points, point_size, faces, depth, opts, comm)?;
+    rec.ddg(&d, built, t_ddg.elapsed().as_secs_f64());
     // §6 step 2: weights and the balanced split.
-    let t0 = Instant::now();
-    // The locator alongside: METIS runs on one thread.
-    let (loc, (w, part0, t_w, t_split)) = rayon::join(
-        || Locator::new(&d),
-        || {
-            let w = ddg::tet_weights(&d, size);
-            let t_w = t0.elapsed().as_secs_f64();
-            let t1 = Instant::now();
-            let part0 = ddg::partition(&d, &w, size, np, opts.partition);
-            (w, part0, t_w, t1.elapsed().as_secs_f64())
-        },
-    );
-    st.split_seconds = t_split;
-    let t_rcb = t0.elapsed().as_secs_f64();
-    st.predicted_imbalance = ddg::imbalance(&part0, &w, np);
-    // Passes 2 and 3 shift it once pass 1 has shown where its front is
-    // left (`order_for_shift`).
-    let mut part0 = part0;
-    let (mut part2, mut part3) = (Vec::new(), Vec::new());
-    st.partition_seconds = t0.elapsed().as_secs_f64();
-    st.partition = opts.partition;
-    st.cut_faces = ddg::cut_faces(&d, &part0);
-    st.cut_fine_faces = ddg::cut_fine_faces(&d, &part0, size);
-    st.max_components = ddg::components(&d, &part0, np)
-        .into_iter()
-        .max()
-        .unwrap_or(0);
-    let cpu2 = process_cpu_seconds();
-    if let (Some(a), Some(b), Some(c)) = (cpu0, cpu1, cpu2) {
-        st.ddg_cpu_seconds = b - a;
-        st.partition_cpu_seconds = c - b;
-    }
-    if tracing::enabled!(tracing::Level::DEBUG) {
-        tracing::debug!(
-            "partition: weights {t_w:.3} s, split {t_split:.3} s (with the locator {t_rcb:.3} s)"
-        );
-    }
+    let (loc, w, base) = split_ddg(&d, size, opts, np, &mut rec);
 
     let mut parts = seed_parts(np, points, point_size, faces);
     let mut next_gid = points.len() as u32;
-    st.seeds = seed_inner_parts(&mut parts, &d, &loc, &part0, size, &mut next_gid);
-    let mut made_per_part = vec![0usize; np];
-
-    // §7 step 3, passes 1 to 3; then, while the front left would make
-    // pass 4 large, passes on a crossing partition (the other method and
-    // its two shifts): what passes 2 and 3 leave sits where the walls of
-    // both shifts meet, inside the crossing parts (P >= 32 on 1M tets).
-    let mut crossing: Vec<Vec<u32>> = Vec::new();
-    for j in 0..3 + MAX_CROSSING {
-        if j >= 3 {
-            let left = comm.all_reduce(parts.iter().map(|p| p.front.len()).collect(), |a, b| a + b);
-            let made: usize = st.pass_tets.iter().sum();
-            if (left as f64) < CROSSING_FROM * made as f64 {
-                break;
-            }
-        }
-        if j == 3 {
-            let t = Instant::now();
-            let method = match opts.partition {
-                Partition::Rcb => Partition::Metis,
-                Partition::Metis => Partition::Rcb,
-            };
-            crossing = vec![ddg::partition(&d, &w, size, np, method)];
-            st.partition_seconds += t.elapsed().as_secs_f64();
-        }
-        if j == 1 || j == 4 {
-            // Name the parts so that the next shift shares out what the
-            // pass on the unshifted partition left, then shift it (§7
-            // passes 2 and 3; the crossing partition likewise).
-            let t = Instant::now();
-            let left = front_left_per_tet(&parts, comm, &loc, d.tets.len());
-            let base = if j == 1 { &mut part0 } else { &mut crossing[0] };
-            let label = ddg::order_for_shift(&d, base, &left, opts.layers, np);
-            for k in base.iter_mut() {
-                *k = label[*k as usize];
-            }
-            let up = ddg::shifted(&d, base, Shift::FromHigher, opts.layers);
-            let down = ddg::shifted(&d, base, Shift::FromLower, opts.layers);
-            if tracing::enabled!(tracing::Level::DEBUG) {
-                let loads = ddg::shift_loads(&d, base, &left, opts.layers, np);
-                tracing::debug!(
-                    "relabelled for pass {}: {:.3} s, front left per part {loads:?}",
-                    j + 1,
-                    t.elapsed().as_secs_f64()
-                );
-            }
-            if j == 1 {
-                let mut made = vec![0; np];
-                for (k, &n) in made_per_part.iter().enumerate() {
-                    made[label[k] as usize] = n;
-                }
-                made_per_part = made;
-                (part2, part3) = (up, down);
-            } else {
-                crossing.extend([up, down]);
-            }
-            st.partition_seconds += t.elapsed().as_secs_f64();
-        }
-        // Partition work above counts in `partition_seconds`, not here.
-        let t0 = Instant::now();
-        let part_of: &[u32] = match j {
-            0 => &part0,
-            1 => &part2,
-            2 => &part3,
-            _ => &crossing[j - 3],
-        };
-        // The crossing passes count as pass 3.
-        let label = j.min(2);
-        let regions = DdgRegions {
-            d: &d,
-            loc: &loc,
-            walls: Interfaces::new(&d, part_of),
-            part_of,
-        };
-        let (tets, secs) = parallel_pass(
-            &mut parts,
-            comm,
-            &regions,
-            Sizes::fine(size),
-            label as u8 + 1,
-            &mut next_gid,
-        )?;
-        for (k, &n) in tets.iter().enumerate() {
-            made_per_part[k] += n;
-        }
-        st.pass_tets[label] += tets.iter().sum::<usize>();
-        st.part_seconds.push(secs);
-        st.crossing_passes = j.saturating_sub(2);
-        if tracing::enabled!(tracing::Level::DEBUG) {
-            let fr: usize = parts.iter().map(|p| p.front.len()).sum();
-            let stuck: usize = parts.iter().map(|p| p.stuck.len() / 3).sum();
-            tracing::debug!(
-                "pass {} tets {:?} front left {fr}, {stuck} stuck",
-                if j < 3 {
-                    format!("{}", j + 1)
-                } else {
-                    format!("3 (crossing {})", j - 2)
-                },
-                tets
-            );
-        }
-        // Room for the next pass around what this one left stuck.
-        let peeled = peel_stuck(&mut parts, comm);
-        if tracing::enabled!(tracing::Level::DEBUG) {
-            tracing::debug!(
-                "after pass {}: {peeled} tets peeled around stuck faces",
-                j + 1
-            );
-        }
-        st.peeled_tets += peeled;
-        st.pass_seconds[label] += t0.elapsed().as_secs_f64();
-    }
-    let mean = made_per_part.iter().sum::<usize>() as f64 / np as f64;
-    st.made_imbalance = if mean > 0.0 {
-        *made_per_part.iter().max().unwrap() as f64 / mean
-    } else {
-        1.0
+    rec.st.seeds = seed_inner_parts(&mut parts, &d, &loc, &base, size, &mut next_gid);
+    // §7 step 3, passes 1 to 3 and the crossing passes.
+    let mut on = Partitions::new(base);
+    let passes = Passes {
+        d: &d,
+        loc: &loc,
+        w: &w,
+        size,
+        opts,
+        comm,
     };
+    passes.run(&mut parts, &mut on, &mut next_gid, &mut rec)?;
+    rec.parallel_done();
 
     // A thin part leaves most of its volume to pass 4: then the serial
     // front on the whole region is both faster and the serial mesh.
@@ -581,26 +445,87 @@ pub fn mesh_parallel<C: Comm>(
         &PASS4_ROUNDS,
         opts.fill_after,
     )?;
-    st.pass_tets[3] = made4;
-    st.peeled_tets += removed;
-    st.pass_seconds[3] = t0.elapsed().as_secs_f64();
+    rec.pass4(made4, removed, t0.elapsed().as_secs_f64());
 
     // §8 step 4.
     let t0 = Instant::now();
-    let out = redistribute::run(parts, comm, &loc, &part0, points, next_gid)?;
-    st.redistribute_seconds = t0.elapsed().as_secs_f64();
-    st.pass_tets = [0; 4];
-    for &p in &out.tet_pass {
-        st.pass_tets[p as usize - 1] += 1;
+    let out = redistribute::run(parts, comm, &loc, &on.base, points, next_gid)?;
+    Ok(rec.finish(out, t0.elapsed().as_secs_f64()))
+}
+
+/// The DDG of the front: by `opts.ddg_passes` parallel passes, or by the
+/// serial front when there are none or they fail, with their stats.
+fn the_ddg<C: Comm>(
+    points: &[P3],
+    point_size: &[f64],
+    faces: &[[u32; 3]],
+    depth: f64,
+    opts: &ParOptions,
+    comm: &C,
+) -> Result<(Ddg, Option<DdgBuildStats>), PassError> {
+    if opts.ddg_passes > 0 {
+        let (c, passes, cap) = (opts.growth, opts.ddg_passes, opts.ddg_cap);
+        match ddg_build::build_ddg_at(points, faces, depth, c, passes, cap, comm) {
+            Ok((d, bs)) => return Ok((d, Some(bs))),
+            // The serial front gets another go (deterministic: the same
+            // failure on any thread count).
+            Err(e) => {
+                if tracing::enabled!(tracing::Level::DEBUG) {
+                    tracing::debug!("the DDG's passes failed ({e}); the serial front builds it");
+                }
+            }
+        }
     }
-    let held: Vec<usize> = out.pieces.iter().map(|p| p.tets.len()).collect();
-    let mean = held.iter().sum::<usize>() as f64 / np as f64;
-    st.held_imbalance = if mean > 0.0 {
-        *held.iter().max().unwrap() as f64 / mean
-    } else {
-        1.0
-    };
-    Ok(ParOutput { stats: st, ..out })
+    let d = ddg::build(
+        points.to_vec(),
+        point_size.to_vec(),
+        faces.to_vec(),
+        opts.growth,
+    )
+    .map_err(PassError::Ddg)?;
+    Ok((d, None))
+}
+
+/// §6 step 2: the DDG's locator, its tet weights and the balanced split
+/// into `np` parts, with their statistics.
+fn split_ddg(
+    d: &Ddg,
+    size: &(dyn Fn(P3) -> f64 + Sync),
+    opts: &ParOptions,
+    np: usize,
+    rec: &mut Recorder,
+) -> (Locator, Vec<f64>, Vec<u32>) {
+    let st = &mut rec.st;
+    let t0 = Instant::now();
+    // The locator alongside: METIS runs on one thread.
+    let (loc, (w, part0, t_w, t_split)) = rayon::join(
+        || Locator::new(d),
+        || {
+            let w = ddg::tet_weights(d, size);
+            let t_w = t0.elapsed().as_secs_f64();
+            let t1 = Instant::now();
+            let part0 = ddg::partition(d, &w, size, np, opts.partition);
+            (w, part0, t_w, t1.elapsed().as_secs_f64())
+        },
+    );
+    st.split_seconds = t_split;
+    let t_rcb = t0.elapsed().as_secs_f64();
+    st.predicted_imbalance = ddg::imbalance(&part0, &w, np);
+    st.partition_seconds = t0.elapsed().as_secs_f64();
+    st.partition = opts.partition;
+    st.cut_faces = ddg::cut_faces(d, &part0);
+    st.cut_fine_faces = ddg::cut_fine_faces(d, &part0, size);
+    st.max_components = ddg::components(d, &part0, np)
+        .into_iter()
+        .max()
+        .unwrap_or(0);
+    rec.partitioned();
+    if tracing::enabled!(tracing::Level::DEBUG) {
+        tracing::debug!(
+            "partition: weights {t_w:.3} s, split {t_split:.3} s (with the locator {t_rcb:.3} s)"
+        );
+    }
+    (loc, w, part0)
 }
 
 /// How the passes' fronts size new tets: the field, and the tallest tet
@@ -620,13 +545,6 @@ impl<'a> Sizes<'a> {
         }
     }
 }
-
-/// Crossing passes after pass 3: one on a partition by the other method,
-/// then one on each of its shifts.
-const MAX_CROSSING: usize = 3;
-/// A crossing pass runs while the front left has more faces than this
-/// share of the tets made (pass 4 makes about a tet per face left).
-const CROSSING_FROM: f64 = 0.0025;
 
 /// Share of the region's volume left after pass 3 above which the region
 /// is meshed serially instead ([`PassError::Unsuited`];

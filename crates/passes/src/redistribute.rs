@@ -13,6 +13,7 @@ use rustc_hash::FxHashMap;
 /// One part of the partitioned mesh.
 #[derive(Clone, Debug, Default)]
 pub struct Piece {
+    /// The points its tets use.
     pub points: Vec<P3>,
     /// Global point id (the merged mesh's numbering).
     pub gid: Vec<u32>,
@@ -21,7 +22,9 @@ pub struct Piece {
     pub owner: Vec<u32>,
     /// Local point ids.
     pub tets: Vec<[u32; 4]>,
+    /// Global tet id (by part, then local order).
     pub tet_gid: Vec<u32>,
+    /// Pass (1 to 4) that made each tet.
     pub tet_pass: Vec<u8>,
     /// Parts sharing points with this one, ascending.
     pub neighbours: Vec<u32>,
@@ -98,10 +101,11 @@ pub(crate) fn run<C: Comm>(
                         pc.points.len() as u32 - 1
                     });
                     if pc.gid[i as usize] != g {
-                        return Err(PassError::Redistribute(format!(
-                            "points {} and {g} are both at {p:?}",
-                            pc.gid[i as usize]
-                        )));
+                        return Err(PassError::Coincident {
+                            a: pc.gid[i as usize],
+                            b: g,
+                            at: p,
+                        });
                     }
                     tv[c] = i;
                 }
@@ -211,9 +215,7 @@ pub(crate) fn run<C: Comm>(
         tet_pass.extend_from_slice(&pc.tet_pass);
     }
     if let Some(g) = seen.iter().position(|&s| !s) {
-        return Err(PassError::Redistribute(format!(
-            "point {g} is in no tet of any part"
-        )));
+        return Err(PassError::Unused { point: g as u32 });
     }
     let _ = np;
     Ok(ParOutput {

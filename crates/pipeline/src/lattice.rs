@@ -1,6 +1,6 @@
 //! Improvement (§9) around the lattice (§2): the lattice's inner tets are
 //! ideal and their points frozen, so they are set aside while the rest is
-//! improved, and cost it nothing (issue 21: "lattice tets cost nothing").
+//! improved, and cost it nothing.
 use parafront_improve::{improve, ImproveOptions, ImproveStats};
 use parafront_mesh::{PointId, TetMesh, TopoError};
 

@@ -3,18 +3,21 @@
 //! passes, redistribution, improvement) slot in between the front and the
 //! check. The CLI is a thin layer over [`mesh_surface`].
 #![forbid(unsafe_code)]
+#![warn(missing_docs)]
 
 mod lattice;
 mod regions;
+mod summary;
 
 pub use parafront_ddg::Partition;
 pub use regions::{material_regions, RegionFront};
+pub use summary::{Stage, Summary};
 
 use parafront_ddg::DdgError;
 use parafront_front::{advance, FrontError, FrontInput, FrontOptions, SizeMode};
 use parafront_lattice::{Lattice, LatticeOptions};
-use parafront_mesh::{CheckError, PointId, QualityReport, TetMesh};
-use parafront_passes::{mesh_parallel, ParOptions, ParOutput, ParStats, PassError, Piece};
+use parafront_mesh::{CheckError, PointId, QualityReport, TetMesh, TopoError};
+use parafront_passes::{mesh_parallel, ParOptions, ParOutput, PassError};
 pub use parafront_passes::{process_cpu_seconds, DDG_CAP, SERIAL_FROM, THIN_DEPTH};
 use parafront_size::{SizeError, SizeField, SizeOptions, Sizing};
 use parafront_surface::validate::{shells, validate, Report, Shell, ShellKind};
@@ -78,7 +81,7 @@ pub struct MeshOptions {
     #[serde(default)]
     pub optimize_parts: usize,
     /// Recovery rounds of a stalled front before the constrained fill
-    /// closes its cavities, and between the fill's tries (issue 20); 0: only
+    /// closes its cavities, and between the fill's tries; 0: only
     /// where the front would give up.
     #[serde(default = "default_fill_after")]
     pub fill_after: u32,
@@ -162,7 +165,9 @@ pub enum LatticeMode {
     /// the tets for 0.09 s).
     #[default]
     Auto,
+    /// Always.
     On,
+    /// Never.
     Off,
 }
 
@@ -178,78 +183,57 @@ impl std::str::FromStr for LatticeMode {
     }
 }
 
+/// Why [`mesh_surface`] made no mesh; each names the region, stage or
+/// element at fault.
 #[derive(Debug, thiserror::Error)]
 pub enum MeshError {
+    /// The surface failed validation (AF5): its report.
     #[error("the surface is not valid for meshing:\n{0}")]
     InvalidSurface(Box<Report>),
+    /// The size field could not be built (AG1).
     #[error("size field: {0}")]
     Size(#[from] SizeError),
+    /// The serial front failed on a region (§4).
     #[error("region {region}: {source}")]
-    Front { region: usize, source: FrontError },
+    Front {
+        /// The region (as in the mesh).
+        region: usize,
+        /// Why the front failed.
+        source: FrontError,
+    },
+    /// The parallel mesher failed on a region, where the serial front
+    /// cannot take over (§5 to §8).
     #[error("region {region}: {source}")]
-    Parallel { region: usize, source: PassError },
+    Parallel {
+        /// The region (as in the mesh).
+        region: usize,
+        /// Why the passes failed.
+        source: PassError,
+    },
+    /// The mesh failed its final check.
     #[error("the generated mesh failed its check (this is a bug in parafront): {0}")]
     Check(#[from] CheckError),
-    #[error("{0}")]
-    Topology(String),
-}
-
-/// What a run made, for the summary line and the benchmark tables.
-#[derive(Clone, Debug, Default)]
-pub struct Summary {
-    /// Threads the run had (`MeshOptions::threads`, or the pool's).
-    pub threads: usize,
-    pub tets: usize,
-    pub points: usize,
-    pub regions: usize,
-    /// (stage, seconds), in pipeline order.
-    pub stages: Vec<(&'static str, f64)>,
-    pub recovery_rounds: u32,
-    pub tets_removed: usize,
-    /// Cavities a stalled front handed to the constrained Delaunay fill,
-    /// and the tets the fill made (issue 20).
-    pub cavities_filled: usize,
-    pub fill_tets: usize,
-    /// Tets and cubes of the optimal space-filling lattice (§2).
-    pub lattice_tets: usize,
-    pub lattice_cells: usize,
-    /// Regions the front could not close at all, filled whole by the
-    /// constrained fill of their surface instead: valid, but coarse (their
-    /// tets follow the surface, not the size field). Ids as in `Front`
-    /// errors.
-    pub regions_filled: Vec<usize>,
-    /// Shells (ids as `parafront check` prints them) oriented as inner
-    /// bodies and meshed as voids, without `regions`.
-    pub voided_shells: Vec<usize>,
-    /// Regions (ids as in the mesh) the parallel passes could not close,
-    /// or left mostly to pass 4, meshed by the serial front instead, with
-    /// the reason.
-    pub serial_fallback: Vec<(usize, String)>,
-    /// Quality of the front's mesh before improvement (when it ran).
-    pub quality_before: Option<QualityReport>,
-    /// Quality of the mesh returned, with edge lengths against the run's
-    /// size field (unless `MeshOptions::no_quality`).
-    pub quality: Option<QualityReport>,
-    /// What improvement did, per operation (when it ran).
-    pub improve: Option<parafront_improve::ImproveStats>,
-    /// Per region, what the parallel passes did (empty with one part).
-    pub parallel: Vec<ParStats>,
-    /// The partitioned mesh, one piece per region and part, with global
-    /// ids in the merged mesh's numbering (empty with one part).
-    pub pieces: Vec<Piece>,
-}
-
-impl Summary {
-    pub fn seconds(&self, stage: &str) -> f64 {
-        self.stages
-            .iter()
-            .filter(|s| s.0 == stage)
-            .map(|s| s.1)
-            .sum()
-    }
-    pub fn total_seconds(&self) -> f64 {
-        self.stages.iter().map(|s| s.1).sum()
-    }
+    /// Improvement (§9) found the front's tets not face-adjacent.
+    #[error("mesh improvement: {source}")]
+    Improve {
+        /// What is wrong with the tets.
+        source: TopoError,
+    },
+    /// The final mesh's tets are not face-adjacent.
+    #[error("the generated mesh failed its check (this is a bug in parafront): {source}")]
+    Adjacency {
+        /// What is wrong with the tets.
+        source: TopoError,
+    },
+    /// A tet whose volume is positive exactly but not in floating point.
+    #[error(
+        "tet {tet} is positive only under exact arithmetic (its floating-point volume is not positive); \
+         the front does not yet avoid such slivers"
+    )]
+    FloatVolume {
+        /// The tet.
+        tet: usize,
+    },
 }
 
 /// Mesh the volume bounded by `s`. The result keeps the surface triangle
@@ -305,11 +289,11 @@ fn mesh_surface_here(s: &Surface, opts: &MeshOptions) -> Result<(TetMesh, Summar
     };
     sum.voided_shells = voided;
     let fronts = material_regions(s, &report.shells);
-    sum.stages.push(("validate", t0.elapsed().as_secs_f64()));
+    sum.push(Stage::Validate, t0.elapsed().as_secs_f64());
 
     let t0 = Instant::now();
     let sizing = Sizing::build(s, &opts.size, None)?;
-    sum.stages.push(("size field", t0.elapsed().as_secs_f64()));
+    sum.push(Stage::SizeField, t0.elapsed().as_secs_f64());
 
     let t0 = Instant::now();
     let mut mesh = surface_mesh(s);
@@ -334,7 +318,7 @@ fn mesh_surface_here(s: &Surface, opts: &MeshOptions) -> Result<(TetMesh, Summar
             &mut sum,
             &mut lattice_inner,
         )?;
-        sum.stages.push(("front", t0.elapsed().as_secs_f64()));
+        sum.push(Stage::Front, t0.elapsed().as_secs_f64());
     }
 
     if opts.optimize > 0 {
@@ -348,9 +332,9 @@ fn mesh_surface_here(s: &Surface, opts: &MeshOptions) -> Result<(TetMesh, Summar
             parts: opts.optimize_parts,
         };
         let st = lattice::improve_around_lattice(&mut mesh, s.points.len(), &lattice_inner, &io)
-            .map_err(|e| MeshError::Topology(e.to_string()))?;
+            .map_err(|source| MeshError::Improve { source })?;
         sum.improve = Some(st);
-        sum.stages.push(("improve", t0.elapsed().as_secs_f64()));
+        sum.push(Stage::Improve, t0.elapsed().as_secs_f64());
         // The pieces number the mesh before improvement, which swaps and
         // collapses have changed: none is better than a stale one.
         sum.pieces.clear();
@@ -358,7 +342,7 @@ fn mesh_surface_here(s: &Surface, opts: &MeshOptions) -> Result<(TetMesh, Summar
 
     let t0 = Instant::now();
     mesh.build_adjacency()
-        .map_err(|e| MeshError::Topology(e.to_string()))?;
+        .map_err(|source| MeshError::Adjacency { source })?;
     if !opts.no_check {
         mesh.check_against_surface(&s.tris)?;
         // Exactly positive is not enough: a solver computes volumes in
@@ -367,19 +351,16 @@ fn mesh_surface_here(s: &Surface, opts: &MeshOptions) -> Result<(TetMesh, Summar
             let p = mesh.tet_points(parafront_mesh::TetId::new(t));
             parafront_geom::tet_volume6(p[0], p[1], p[2], p[3]) <= 0.0
         }) {
-            return Err(MeshError::Topology(format!(
-                "tet {t} is positive only under exact arithmetic (its floating-point volume is not positive); \
-                 the front does not yet avoid such slivers"
-            )));
+            return Err(MeshError::FloatVolume { tet: t });
         }
     }
-    sum.stages.push(("check", t0.elapsed().as_secs_f64()));
+    sum.push(Stage::Check, t0.elapsed().as_secs_f64());
     if !opts.no_quality {
         // With the run's size field: building it again for the report took
         // as long as the size field stage.
         let t0 = Instant::now();
         sum.quality = Some(QualityReport::with_size(&mesh, |p| sizing.size(p)));
-        sum.stages.push(("quality", t0.elapsed().as_secs_f64()));
+        sum.push(Stage::Quality, t0.elapsed().as_secs_f64());
     }
     sum.tets = mesh.tets.len();
     sum.points = mesh.points.len();
@@ -618,7 +599,8 @@ fn mesh_parts(
         ..ParOptions::default()
     };
     let comm = parafront_comm::Threads::new(opts.parts);
-    let mut stage = [0.0f64; 7];
+    // Seconds of each of `Stage::PARALLEL`, summed over the regions.
+    let mut stage = [0.0f64; Stage::PARALLEL.len()];
     for rf in fronts {
         let (pts, hs) = region_points(s, sizing, rf);
         let t_par = Instant::now();
@@ -640,11 +622,10 @@ fn mesh_parts(
                 );
                 sum.serial_fallback
                     .push((rf.region_id as usize, e.to_string()));
-                sum.stages
-                    .push(("passes given up", t_par.elapsed().as_secs_f64()));
+                sum.push(Stage::PassesGivenUp, t_par.elapsed().as_secs_f64());
                 let t0 = Instant::now();
                 serial_region(s, rf, sizing, opts, mesh, sum, &mut Vec::new())?;
-                sum.stages.push(("front", t0.elapsed().as_secs_f64()));
+                sum.push(Stage::Front, t0.elapsed().as_secs_f64());
                 continue;
             }
             Err(e) => {
@@ -681,19 +662,8 @@ fn mesh_parts(
     if sum.parallel.is_empty() {
         return Ok(()); // every region went to the serial front
     }
-    for (name, x) in [
-        "ddg",
-        "partition",
-        "pass 1",
-        "pass 2",
-        "pass 3",
-        "pass 4",
-        "redistribute",
-    ]
-    .into_iter()
-    .zip(stage)
-    {
-        sum.stages.push((name, x));
+    for (name, x) in Stage::PARALLEL.into_iter().zip(stage) {
+        sum.push(name, x);
     }
     Ok(())
 }

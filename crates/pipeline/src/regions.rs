@@ -18,6 +18,8 @@ pub struct RegionFront {
     pub faces: Vec<[u32; 3]>,
 }
 
+/// The regions of `s`, one per material shell in shell order (`shells`
+/// from `validate`), each with the front that bounds it (AF1).
 pub fn material_regions(s: &Surface, shells: &[Shell]) -> Vec<RegionFront> {
     let mut out = Vec::new();
     for (i, sh) in shells.iter().enumerate() {

@@ -2,7 +2,7 @@
 //! PARAFRONT_GEOMETRY is unset). Each mesh must keep its surface and fill it
 //! exactly. Not in the list: the two largest models (boot, skull: about a
 //! minute each).
-use parafront_pipeline::{mesh_surface, MeshOptions};
+use parafront_pipeline::{mesh_surface, MeshOptions, Stage};
 use parafront_surface::read::read_surface;
 use std::path::PathBuf;
 
@@ -35,7 +35,7 @@ fn mesh_file(file: &str) {
     println!(
         "{file}: {} tets, front {:.2} s, {} recovery rounds",
         m.tets.len(),
-        summary.seconds("front"),
+        summary.seconds(Stage::Front),
         summary.recovery_rounds
     );
     assert!(m.tets.len() > s.tris.len(), "{file}: {} tets", m.tets.len());

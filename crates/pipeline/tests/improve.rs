@@ -5,7 +5,7 @@
 use parafront_improve::{improve, ImproveOptions, Improver, Outcome};
 use parafront_mesh::quality::{mean_ratio, TET_EDGES};
 use parafront_mesh::{QualityReport, TetMesh};
-use parafront_pipeline::{mesh_surface, MeshOptions};
+use parafront_pipeline::{mesh_surface, MeshOptions, Stage};
 use parafront_surface::{generate, Surface};
 
 fn front_mesh(s: &Surface) -> TetMesh {
@@ -82,7 +82,7 @@ fn pipeline_improves_by_default() {
     let before = sum.quality_before.expect("improvement ran");
     let st = sum.improve.expect("improvement ran");
     assert_eq!(st.tets_after, m.tets.len());
-    assert!(sum.stages.iter().any(|s| s.0 == "improve"));
+    assert!(sum.stages.iter().any(|s| s.0 == Stage::Improve));
     let q = QualityReport::new(&m);
     assert!(q.share_min_dihedral_below < before.share_min_dihedral_below);
     let (m0, sum0) = mesh_surface(

@@ -1,7 +1,7 @@
 //! The whole pipeline on generated surfaces: the result keeps the surface,
 //! fills it exactly, is deterministic, and its tets are far from flat.
 use parafront_mesh::quality::QualityReport;
-use parafront_pipeline::{mesh_surface, MeshOptions};
+use parafront_pipeline::{mesh_surface, MeshOptions, Stage};
 use parafront_surface::{generate, Surface};
 
 fn mesh(s: &Surface) -> parafront_mesh::TetMesh {
@@ -180,8 +180,8 @@ fn no_quality_skips_the_report_only() {
         ..MeshOptions::default()
     };
     let (m1, s1) = mesh_surface(&s, &o).unwrap();
-    assert!(s0.quality.is_some() && s0.seconds("quality") > 0.0);
+    assert!(s0.quality.is_some() && s0.seconds(Stage::Quality) > 0.0);
     assert!(s1.quality.is_none());
-    assert!(s1.stages.iter().all(|st| st.0 != "quality"));
+    assert!(s1.stages.iter().all(|st| st.0 != Stage::Quality));
     assert_eq!(m0.tets, m1.tets);
 }

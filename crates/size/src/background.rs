@@ -21,6 +21,8 @@ thread_local! {
     static HINT: Cell<u32> = const { Cell::new(0) };
 }
 
+/// A background tet grid with a size at each node, interpolated linearly
+/// inside each tet (AG1's background mesh).
 #[derive(Clone, Debug)]
 pub struct BackgroundGrid {
     points: Vec<P3>,

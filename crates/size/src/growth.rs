@@ -73,15 +73,22 @@ enum Decision {
 /// Build statistics (for reports and tests).
 #[derive(Clone, Debug, Default)]
 pub struct GrowthStats {
+    /// Surface points the size grows from.
     pub seeds: usize,
+    /// Octree nodes.
     pub nodes: usize,
+    /// Leaves that take the min over a list of candidate seeds.
     pub near_leaves: usize,
+    /// Leaves that interpolate the field from their corners.
     pub far_leaves: usize,
+    /// Candidate seeds over all near leaves.
     pub candidates: usize,
     /// Near leaves forced by the depth or node cap whose list was cut: the
     /// field may be too large there.
     pub truncated: usize,
+    /// Depth of the octree.
     pub depth: u32,
+    /// Bytes of the octree, its lists and seeds (an estimate).
     pub bytes: usize,
 }
 
@@ -461,10 +468,12 @@ impl SurfaceGrowth {
             .fold(self.cap, f64::min)
     }
 
+    /// The growth per unit distance, `g - 1`.
     pub fn slope(&self) -> f64 {
         self.c
     }
 
+    /// What the build made.
     pub fn stats(&self) -> &GrowthStats {
         &self.stats
     }

@@ -15,6 +15,7 @@
 //! [`SizeCursor`] per thread and call [`Sizing::size_with`]: queries near the
 //! previous one then skip the octree descent and the tet search.
 #![forbid(unsafe_code)]
+#![warn(missing_docs)]
 
 pub mod background;
 pub mod growth;
@@ -35,23 +36,72 @@ use std::path::PathBuf;
 /// A spatially varying element size. Implementations must be cheap and
 /// safe to call from many threads.
 pub trait SizeField: Send + Sync {
+    /// The element size wanted at `p`.
     fn size(&self, p: P3) -> f64;
 }
 
+/// Why the size field cannot be built; each names what is wrong.
 #[derive(Debug, thiserror::Error)]
 pub enum SizeError {
+    /// A size options file that is not valid TOML for [`SizeOptions`].
     #[error("{origin}: {msg}")]
-    Toml { origin: String, msg: String },
+    Toml {
+        /// Where the text came from (a file name).
+        origin: String,
+        /// What `toml` said: line, column and key.
+        msg: String,
+    },
+    /// A size options file that cannot be read.
     #[error("{}: {msg}", path.display())]
-    Io { path: PathBuf, msg: String },
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// What the system said.
+        msg: String,
+    },
+    /// An option out of its range.
     #[error("size options: {what}: {why}")]
-    Invalid { what: String, why: String },
-    #[error("surface: {0}")]
-    Surface(String),
+    Invalid {
+        /// The option.
+        what: String,
+        /// What is wrong with its value.
+        why: String,
+    },
+    /// A surface point with a NaN or infinite coordinate.
+    #[error("surface: point {point} has non-finite coordinates {at:?}")]
+    NonFinitePoint {
+        /// The point.
+        point: usize,
+        /// Its coordinates.
+        at: P3,
+    },
+    /// A triangle naming a point past the end of the surface's points.
+    #[error("surface: triangle {tri} refers to point {point}, but there are {points} points")]
+    PointOutOfRange {
+        /// The triangle.
+        tri: usize,
+        /// The point it names.
+        point: u32,
+        /// Points in the surface.
+        points: usize,
+    },
+    /// A surface point whose edges give no positive, finite size (AG3).
     #[error("surface point {point} at {at:?} gets no usable size ({size}) from its incident edges (zero or overflowing lengths; set hmin > 0 or fix the surface)")]
-    ZeroSize { point: usize, at: P3, size: f64 },
+    ZeroSize {
+        /// The point.
+        point: usize,
+        /// Its coordinates.
+        at: P3,
+        /// The size its edges give.
+        size: f64,
+    },
+    /// A background grid that cannot be used.
     #[error("background grid: {why}")]
-    Background { why: String },
+    Background {
+        /// What is wrong with it.
+        why: String,
+    },
+    /// Nothing bounds the size.
     #[error("no size given: set h or hmax, or give a surface, sources or a background grid")]
     NoSize,
 }
@@ -100,16 +150,16 @@ impl Sizing {
         let np = surface.points.len();
         for (i, p) in surface.points.iter().enumerate() {
             if !p.iter().all(|x| x.is_finite()) {
-                return Err(SizeError::Surface(format!(
-                    "point {i} has non-finite coordinates {p:?}"
-                )));
+                return Err(SizeError::NonFinitePoint { point: i, at: *p });
             }
         }
         for (t, tri) in surface.tris.iter().enumerate() {
             if let Some(v) = tri.iter().find(|&&v| v as usize >= np) {
-                return Err(SizeError::Surface(format!(
-                    "triangle {t} refers to point {v}, but there are {np} points"
-                )));
+                return Err(SizeError::PointOutOfRange {
+                    tri: t,
+                    point: *v,
+                    points: np,
+                });
             }
         }
 
@@ -184,6 +234,7 @@ impl Sizing {
         (hq + (self.gradation - 1.0) * dist(p, q)).clamp(self.hmin, self.cap)
     }
 
+    /// The smallest size.
     pub fn hmin(&self) -> f64 {
         self.hmin
     }
@@ -191,6 +242,7 @@ impl Sizing {
     pub fn hmax(&self) -> f64 {
         self.cap
     }
+    /// The size grown from the surface, when there is one.
     pub fn growth(&self) -> Option<&SurfaceGrowth> {
         self.growth.as_ref()
     }

@@ -34,6 +34,7 @@ pub struct SizeOptions {
     /// Grow the size from the surface points (mean incident edge length).
     #[serde(default = "yes")]
     pub surface_growth: bool,
+    /// Size sources ([`SourceSpec`]).
     #[serde(default)]
     pub sources: Vec<SourceSpec>,
     /// Patch tag -> size imposed at the points of that patch's triangles
@@ -81,47 +82,67 @@ impl Default for SizeOptions {
 pub enum SourceSpec {
     /// Around a point.
     Point {
+        /// The point.
         center: P3,
+        /// The size in the core.
         h0: f64,
+        /// Radius of the core around the geometry (default 0).
         #[serde(default)]
         r0: f64,
+        /// Growth outside the core (default: the gradation).
         #[serde(default)]
         growth: Option<f64>,
     },
     /// Around the segment from `a` to `b`.
     Segment {
+        /// One end.
         a: P3,
+        /// The other end.
         b: P3,
+        /// The size in the core.
         h0: f64,
+        /// Radius of the core around the geometry (default 0).
         #[serde(default)]
         r0: f64,
+        /// Growth outside the core (default: the gradation).
         #[serde(default)]
         growth: Option<f64>,
     },
     /// Around the spherical surface of `radius` about `center` (a shell; for a
     /// solid ball use a point source with `r0 = radius`).
     Sphere {
+        /// The sphere's center.
         center: P3,
+        /// Its radius.
         radius: f64,
+        /// The size in the core.
         h0: f64,
+        /// Radius of the core around the geometry (default 0).
         #[serde(default)]
         r0: f64,
+        /// Growth outside the core (default: the gradation).
         #[serde(default)]
         growth: Option<f64>,
     },
     /// The solid axis-aligned box `[min, max]` (d = 0 inside).
     Box {
+        /// The corner with the smallest coordinates.
         min: P3,
+        /// The corner with the largest coordinates.
         max: P3,
+        /// The size in the core.
         h0: f64,
+        /// Radius of the core around the geometry (default 0).
         #[serde(default)]
         r0: f64,
+        /// Growth outside the core (default: the gradation).
         #[serde(default)]
         growth: Option<f64>,
     },
 }
 
 impl SourceSpec {
+    /// Its `kind` in TOML.
     pub fn kind(&self) -> &'static str {
         match self {
             SourceSpec::Point { .. } => "point",
@@ -160,6 +181,7 @@ impl SizeOptions {
         Ok(o)
     }
 
+    /// Reads and validates a TOML file ([`SizeOptions::from_toml_str`]).
     pub fn from_toml_file(path: &Path) -> Result<SizeOptions, SizeError> {
         let text = std::fs::read_to_string(path).map_err(|e| SizeError::Io {
             path: path.to_path_buf(),
@@ -168,6 +190,8 @@ impl SizeOptions {
         Self::from_toml_str(&text, &path.display().to_string())
     }
 
+    /// As TOML, which [`SizeOptions::from_toml_str`] reads back (empty if
+    /// it cannot be written).
     pub fn to_toml_string(&self) -> String {
         toml::to_string(self).unwrap_or_default()
     }
