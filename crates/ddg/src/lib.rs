@@ -6,10 +6,12 @@
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
+mod check;
 mod field;
 mod locate;
 mod partition;
 
+pub use check::DdgCheckError;
 pub use field::GradedField;
 
 pub use locate::{Interfaces, Locator, PartFilter};
@@ -79,14 +81,16 @@ pub fn build(
         &Everywhere,
         &FrontOptions::default(),
     )?;
-    Ok(Ddg {
+    let d = Ddg {
         points: r.points,
         tets: r.tets,
         neigh: r.neigh,
         n_input,
         growth: c,
         seconds: t0.elapsed().as_secs_f64(),
-    })
+    };
+    debug_assert_eq!(d.check(), Ok(()));
+    Ok(d)
 }
 
 /// The DDG's sizes ([`build`]): the surface sizes of the closed

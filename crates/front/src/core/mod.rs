@@ -13,6 +13,7 @@ use rustc_hash::FxHashMap;
 
 mod candidates;
 mod cavity;
+mod check;
 mod exhaustive;
 mod faces;
 mod fill;
@@ -637,7 +638,9 @@ impl<'a> Front<'a> {
                 && self.relax >= self.opts.fill_after
                 && self.relax.is_multiple_of(self.opts.fill_after);
             if self.opts.fill && (give_up || due) {
-                if self.fill_stalled(self.opts.fill_growth) {
+                let filled = self.fill_stalled(self.opts.fill_growth);
+                debug_assert_eq!(self.check(), Ok(()), "after a fill");
+                if filled {
                     continue;
                 }
                 failed_fills += 1;
@@ -646,6 +649,7 @@ impl<'a> Front<'a> {
                 return Err(self.stuck_error());
             }
             self.recover();
+            debug_assert_eq!(self.check(), Ok(()), "after recovery round {}", self.relax);
         }
     }
 
