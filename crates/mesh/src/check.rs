@@ -147,13 +147,66 @@ impl TetMesh {
         let np = self.points.len();
         let nt = self.tets.len();
         let mut found = Found::default();
+        let Some((neigh_ok, region_ok)) = self.check_arrays(&mut found) else {
+            return Err(found.into_error());
+        };
+        let pf = self.check_points();
+        let finite_ok = pf.is_empty();
+        found = found.merge(pf);
+        let (ta, n_unused_points) = self.check_tets(finite_ok);
+        found = found.merge(ta.found);
+        let (f, in_keys) = match tris {
+            None => (Found::default(), Vec::new()),
+            Some(tris) => input_keys(tris, np),
+        };
+        found = found.merge(f);
+        let keys = face_keys(&self.tets);
+        let fa = self.check_faces(&keys, tris.map(|t| (t, &in_keys[..])), neigh_ok, region_ok);
+        found = found.merge(fa.found);
+        let mut surface_volume = None;
+        if let Some(tris) = tris {
+            let (f, vs) = self.check_input_side(tris, &keys, &in_keys, region_ok, ta.vol6);
+            found = found.merge(f);
+            surface_volume = Some(vs);
+        }
+        if !found.is_empty() {
+            return Err(found.into_error());
+        }
+        let n_regions = if nt == 0 {
+            0
+        } else if self.region.is_empty() {
+            1
+        } else {
+            let mut r = self.region.clone();
+            r.par_sort_unstable();
+            r.dedup();
+            r.len()
+        };
+        Ok(CheckStats {
+            n_points: np,
+            n_unused_points,
+            n_tets: nt,
+            n_regions,
+            n_interior_faces: fa.interior,
+            n_interface_faces: fa.interface,
+            n_boundary_faces: fa.boundary,
+            volume: ta.vol6 / 6.0,
+            min_volume: if nt == 0 { 0.0 } else { ta.min_vol6 / 6.0 },
+            surface_volume,
+        })
+    }
+
+    /// The arrays' lengths: `None` when there are too many tets to check,
+    /// else whether `neigh` and `region` can be used.
+    fn check_arrays(&self, found: &mut Found) -> Option<(bool, bool)> {
+        let nt = self.tets.len();
         if nt > crate::adjacency::MAX_TETS {
             found.push(MeshProblem::ArrayLength {
                 name: "tets",
                 len: nt,
                 expected: format!("at most {}", crate::adjacency::MAX_TETS),
             });
-            return Err(found.into_error());
+            return None;
         }
         let neigh_ok = match self.neigh.len() {
             0 => false,
@@ -175,17 +228,21 @@ impl TetMesh {
                 expected: format!("0 or {nt} (one per tet)"),
             });
         }
-        let region = |t: TetId| -> u32 {
-            if region_ok {
-                self.region_of(t)
-            } else {
-                0
-            }
-        };
+        Some((neigh_ok, region_ok))
+    }
 
-        // Points.
-        let pf = self
-            .points
+    /// Tet `t`'s region, or 0 when the region array is unusable.
+    fn region_or_0(&self, t: TetId, region_ok: bool) -> u32 {
+        if region_ok {
+            self.region_of(t)
+        } else {
+            0
+        }
+    }
+
+    /// Every point finite.
+    fn check_points(&self) -> Found {
+        self.points
             .par_iter()
             .enumerate()
             .fold(Found::default, |mut acc, (i, p)| {
@@ -197,11 +254,13 @@ impl TetMesh {
                 }
                 acc
             })
-            .reduce(Found::default, Found::merge);
-        let finite_ok = pf.is_empty();
-        found = found.merge(pf);
+            .reduce(Found::default, Found::merge)
+    }
 
-        // Tets: ids, repeats, exact orientation, volume.
+    /// Tets: ids, repeats, exact orientation, volume; and the points no
+    /// tet uses.
+    fn check_tets(&self, finite_ok: bool) -> (TetAcc, usize) {
+        let np = self.points.len();
         let used: Vec<AtomicBool> = (0..np)
             .into_par_iter()
             .map(|_| AtomicBool::new(false))
@@ -266,61 +325,26 @@ impl TetMesh {
                     min_vol6: a.min_vol6.min(b.min_vol6),
                 },
             );
-        found = found.merge(ta.found);
         let n_unused_points = used.par_iter().filter(|u| !u.load(Relaxed)).count();
-        drop(used);
+        (ta, n_unused_points)
+    }
 
-        // The input triangles, validated, as sorted keys (low = index).
-        let in_keys: Vec<u128> = match tris {
-            None => Vec::new(),
-            Some(tris) => {
-                let (f, mut keys) = tris
-                    .par_iter()
-                    .enumerate()
-                    .fold(
-                        || (Found::default(), Vec::new()),
-                        |(mut f, mut keys), (i, t)| {
-                            if let Some(&p) = t.iter().find(|&&p| p as usize >= np) {
-                                f.push(MeshProblem::BadInputTriangle {
-                                    tri: i,
-                                    verts: *t,
-                                    why: if p == u32::MAX {
-                                        "uses point id u32::MAX"
-                                    } else {
-                                        "uses a point id past the end of the points"
-                                    },
-                                });
-                            } else if t[0] == t[1] || t[1] == t[2] || t[0] == t[2] {
-                                f.push(MeshProblem::BadInputTriangle {
-                                    tri: i,
-                                    verts: *t,
-                                    why: "repeats a vertex",
-                                });
-                            } else {
-                                keys.push(pack(sort3(*t).0, i as u32));
-                            }
-                            (f, keys)
-                        },
-                    )
-                    .reduce(
-                        || (Found::default(), Vec::new()),
-                        |(fa, mut ka), (fb, kb)| {
-                            ka.extend(kb);
-                            (fa.merge(fb), ka)
-                        },
-                    );
-                found = found.merge(f);
-                keys.par_sort_unstable();
-                keys
-            }
-        };
+    /// Faces: pairing, neigh, and the mesh side of the surface match
+    /// (against the input triangles and their sorted keys, when given).
+    fn check_faces(
+        &self,
+        keys: &[u128],
+        input: Option<(&[[u32; 3]], &[u128])>,
+        neigh_ok: bool,
+        region_ok: bool,
+    ) -> FaceAcc {
+        let tris = input.map(|i| i.0);
+        let in_keys: &[u128] = input.map_or(&[], |i| i.1);
         let in_parity = |k: u128| sort3(tris.unwrap()[low(k) as usize]).1;
-
-        // Faces: pairing, neigh, and the mesh side of the surface match.
-        let keys = face_keys(&self.tets);
+        let region = |t: TetId| self.region_or_0(t, region_ok);
         let tets = &self.tets;
         let pt = |p: PointId| self.points.get(p.idx()).copied().unwrap_or([f64::NAN; 3]);
-        let fa = group_chunks(&keys)
+        group_chunks(keys)
             .par_iter()
             .map(|chunk| {
                 let mut acc = FaceAcc::default();
@@ -374,7 +398,7 @@ impl TetMesh {
                     }
                     // A boundary or interface face: it must be an input triangle.
                     let fr = FaceRef(low(g[0]));
-                    let r = find_triple(&in_keys, unpack_triple(g[0]));
+                    let r = find_triple(in_keys, unpack_triple(g[0]));
                     let tv = unpack_triple(g[0]);
                     if r.is_empty() {
                         let verts = self.face_points(fr);
@@ -413,100 +437,125 @@ impl TetMesh {
                 interior: a.interior + b.interior,
                 interface: a.interface + b.interface,
                 boundary: a.boundary + b.boundary,
-            });
-        found = found.merge(fa.found);
-
-        // The input side: triangles that are no boundary face, and the
-        // enclosed volume (interface triangles enclose nothing).
-        let mut surface_volume = None;
-        if let Some(tris) = tris {
-            let c = Aabb::from_points(&self.points).center();
-            let (f, flux, flux_abs) = group_chunks(&in_keys)
-                .par_iter()
-                .map(|chunk| {
-                    let mut f = Found::default();
-                    let (mut flux, mut flux_abs) = (0.0, 0.0);
-                    for_each_group(chunk, |g| {
-                        let m = find_triple(&keys, unpack_triple(g[0]));
-                        let interface = m.len() == 2
-                            && region(FaceRef(low(m[0])).tet()) != region(FaceRef(low(m[1])).tet());
-                        let why = match m.len() {
-                            0 => Some("no tet has this face".to_string()),
-                            2 if !interface
-                                && face_parity(tets, low(m[0])) != face_parity(tets, low(m[1])) =>
-                            {
-                                let (a, b) = (FaceRef(low(m[0])).tet(), FaceRef(low(m[1])).tet());
-                                Some(format!(
-                                    "it lies inside region {}, between tets {a} and {b}",
-                                    region(a)
-                                ))
-                            }
-                            _ => None,
-                        };
-                        for &k in g {
-                            let t = tris[low(k) as usize];
-                            if let Some(why) = &why {
-                                f.push(MeshProblem::MissingBoundaryFace {
-                                    tri: low(k) as usize,
-                                    verts: t,
-                                    coords: t.map(|p| self.points[p as usize]),
-                                    why: why.clone(),
-                                });
-                            }
-                            if !interface {
-                                let [a, b, d] = t.map(|p| sub(self.points[p as usize], c));
-                                let v = dot(a, cross(b, d));
-                                flux += v;
-                                flux_abs += v.abs();
-                            }
-                        }
-                    });
-                    (f, flux, flux_abs)
-                })
-                .reduce(
-                    || (Found::default(), 0.0, 0.0),
-                    |a, b| (a.0.merge(b.0), a.1 + b.1, a.2 + b.2),
-                );
-            found = found.merge(f);
-            let (vm, vs) = (ta.vol6 / 6.0, flux / 6.0);
-            // Rounding bound of both sums, or the relative tolerance.
-            let tol = (VOLUME_RTOL * vm.abs().max(vs.abs()))
-                .max(64.0 * f64::EPSILON * (ta.vol6 + flux_abs) / 6.0);
-            let diff = (vm - vs).abs();
-            if diff > tol || diff.is_nan() {
-                found.push(MeshProblem::VolumeMismatch {
-                    mesh: vm,
-                    surface: vs,
-                    rel: (vm - vs).abs() / vm.abs().max(vs.abs()),
-                });
-            }
-            surface_volume = Some(vs);
-        }
-
-        if !found.is_empty() {
-            return Err(found.into_error());
-        }
-        let n_regions = if nt == 0 {
-            0
-        } else if self.region.is_empty() {
-            1
-        } else {
-            let mut r = self.region.clone();
-            r.par_sort_unstable();
-            r.dedup();
-            r.len()
-        };
-        Ok(CheckStats {
-            n_points: np,
-            n_unused_points,
-            n_tets: nt,
-            n_regions,
-            n_interior_faces: fa.interior,
-            n_interface_faces: fa.interface,
-            n_boundary_faces: fa.boundary,
-            volume: ta.vol6 / 6.0,
-            min_volume: if nt == 0 { 0.0 } else { ta.min_vol6 / 6.0 },
-            surface_volume,
-        })
+            })
     }
+
+    /// The input side: triangles that are no boundary face, and the
+    /// enclosed volume (interface triangles enclose nothing) against the
+    /// tets' (`vol6`, six times theirs). The problems, and the surface's
+    /// volume.
+    fn check_input_side(
+        &self,
+        tris: &[[u32; 3]],
+        keys: &[u128],
+        in_keys: &[u128],
+        region_ok: bool,
+        vol6: f64,
+    ) -> (Found, f64) {
+        let tets = &self.tets;
+        let region = |t: TetId| self.region_or_0(t, region_ok);
+        let mut found = Found::default();
+        let c = Aabb::from_points(&self.points).center();
+        let (f, flux, flux_abs) = group_chunks(in_keys)
+            .par_iter()
+            .map(|chunk| {
+                let mut f = Found::default();
+                let (mut flux, mut flux_abs) = (0.0, 0.0);
+                for_each_group(chunk, |g| {
+                    let m = find_triple(keys, unpack_triple(g[0]));
+                    let interface = m.len() == 2
+                        && region(FaceRef(low(m[0])).tet()) != region(FaceRef(low(m[1])).tet());
+                    let why = match m.len() {
+                        0 => Some("no tet has this face".to_string()),
+                        2 if !interface
+                            && face_parity(tets, low(m[0])) != face_parity(tets, low(m[1])) =>
+                        {
+                            let (a, b) = (FaceRef(low(m[0])).tet(), FaceRef(low(m[1])).tet());
+                            Some(format!(
+                                "it lies inside region {}, between tets {a} and {b}",
+                                region(a)
+                            ))
+                        }
+                        _ => None,
+                    };
+                    for &k in g {
+                        let t = tris[low(k) as usize];
+                        if let Some(why) = &why {
+                            f.push(MeshProblem::MissingBoundaryFace {
+                                tri: low(k) as usize,
+                                verts: t,
+                                coords: t.map(|p| self.points[p as usize]),
+                                why: why.clone(),
+                            });
+                        }
+                        if !interface {
+                            let [a, b, d] = t.map(|p| sub(self.points[p as usize], c));
+                            let v = dot(a, cross(b, d));
+                            flux += v;
+                            flux_abs += v.abs();
+                        }
+                    }
+                });
+                (f, flux, flux_abs)
+            })
+            .reduce(
+                || (Found::default(), 0.0, 0.0),
+                |a, b| (a.0.merge(b.0), a.1 + b.1, a.2 + b.2),
+            );
+        found = found.merge(f);
+        let (vm, vs) = (vol6 / 6.0, flux / 6.0);
+        // Rounding bound of both sums, or the relative tolerance.
+        let tol = (VOLUME_RTOL * vm.abs().max(vs.abs()))
+            .max(64.0 * f64::EPSILON * (vol6 + flux_abs) / 6.0);
+        let diff = (vm - vs).abs();
+        if diff > tol || diff.is_nan() {
+            found.push(MeshProblem::VolumeMismatch {
+                mesh: vm,
+                surface: vs,
+                rel: (vm - vs).abs() / vm.abs().max(vs.abs()),
+            });
+        }
+        (found, vs)
+    }
+}
+
+/// The input triangles, validated, as sorted keys (low = index).
+fn input_keys(tris: &[[u32; 3]], np: usize) -> (Found, Vec<u128>) {
+    let (f, mut keys) = tris
+        .par_iter()
+        .enumerate()
+        .fold(
+            || (Found::default(), Vec::new()),
+            |(mut f, mut keys), (i, t)| {
+                if let Some(&p) = t.iter().find(|&&p| p as usize >= np) {
+                    f.push(MeshProblem::BadInputTriangle {
+                        tri: i,
+                        verts: *t,
+                        why: if p == u32::MAX {
+                            "uses point id u32::MAX"
+                        } else {
+                            "uses a point id past the end of the points"
+                        },
+                    });
+                } else if t[0] == t[1] || t[1] == t[2] || t[0] == t[2] {
+                    f.push(MeshProblem::BadInputTriangle {
+                        tri: i,
+                        verts: *t,
+                        why: "repeats a vertex",
+                    });
+                } else {
+                    keys.push(pack(sort3(*t).0, i as u32));
+                }
+                (f, keys)
+            },
+        )
+        .reduce(
+            || (Found::default(), Vec::new()),
+            |(fa, mut ka), (fb, kb)| {
+                ka.extend(kb);
+                (fa.merge(fb), ka)
+            },
+        );
+    keys.par_sort_unstable();
+    (f, keys)
 }
