@@ -39,7 +39,37 @@ pub(crate) fn blocks(
     if faces.is_empty() {
         return empty;
     }
-    // Face boxes, and the region's box.
+    let (fb, lo, hi) = face_boxes(points, faces);
+    let extent = (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max);
+    let (hmin, hmax, hmean) = size_range(point_size, faces, size, lo, hi);
+    if !(hmin > 0.0 && hmax.is_finite() && extent > 0.0 && extent.is_finite()) {
+        return empty;
+    }
+    if too_thin(points, faces, lo, hmean, opts.margin) {
+        return empty;
+    }
+    let mut root = CUBE_PER_SIZE * hmax;
+    while root < extent {
+        root *= 2.0;
+    }
+    let c = [0, 1, 2].map(|k| 0.5 * (lo[k] + hi[k]));
+    let mut out = Cells {
+        origin: c.map(|x| x - 0.5 * root),
+        root,
+        cells: Vec::new(),
+    };
+    let inside = Inside::new(points, faces);
+    walk(&mut out, &fb, &inside, size, hmin, hmax, opts.margin);
+    separate(&mut out);
+    manifold(&mut out);
+    drop_small(&mut out, opts.min_cells);
+    out.cells.sort_unstable();
+    out
+}
+
+/// Each face's box, and the region's.
+#[allow(clippy::type_complexity)]
+fn face_boxes(points: &[P3], faces: &[[u32; 3]]) -> (Vec<(P3, P3)>, P3, P3) {
     let fb: Vec<(P3, P3)> = faces
         .iter()
         .map(|f| {
@@ -63,9 +93,20 @@ pub(crate) fn blocks(
             hi[k] = hi[k].max(b.1[k]);
         }
     }
-    let extent = (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max);
-    // The levels' sizes: the largest size in the region, halved per level
-    // (a uniform field is then exactly a level's size).
+    (fb, lo, hi)
+}
+
+/// The smallest and the mean surface size, and the largest size in the
+/// region (the surface's, and the field's on a 7^3 grid over the box
+/// `lo`-`hi`): the levels are the largest halved per level, so a uniform
+/// field is exactly a level's size.
+fn size_range(
+    point_size: &[f64],
+    faces: &[[u32; 3]],
+    size: &(dyn Fn(P3) -> f64 + Sync),
+    lo: P3,
+    hi: P3,
+) -> (f64, f64, f64) {
     let (mut hmin, mut hmax, mut hsum) = (f64::INFINITY, 0.0f64, 0.0);
     for f in faces {
         for &v in f {
@@ -85,13 +126,14 @@ pub(crate) fn blocks(
             }
         }
     }
-    if !(hmin > 0.0 && hmax.is_finite() && extent > 0.0 && extent.is_finite()) {
-        return empty;
-    }
-    // A thin region (three times its volume over its area is a ball's
-    // radius, 1.5 times a slab's thickness) has no room for a cell between
-    // its margins at the surface's mean size: the octree would be
-    // searched in vain.
+    (hmin, hmax, hsum / (3 * faces.len()) as f64)
+}
+
+/// A thin region (three times its volume over its area is a ball's
+/// radius, 1.5 times a slab's thickness) has no room for a cell between
+/// its margins at the surface's mean size `hmean`: the octree would be
+/// searched in vain.
+fn too_thin(points: &[P3], faces: &[[u32; 3]], lo: P3, hmean: f64, margin: f64) -> bool {
     let (mut vol6, mut area2) = (0.0, 0.0);
     for f in faces {
         let [a, b, c] = f.map(|v| points[v as usize]);
@@ -100,26 +142,29 @@ pub(crate) fn blocks(
     }
     // A ball's radius; a slab's thickness is 2/3 of it.
     let depth = 3.0 * (vol6 / 6.0) / (0.5 * area2);
-    let hmean = hsum / (3 * faces.len()) as f64;
-    if !(depth >= (2.0 * opts.margin + 1.0) * CUBE_PER_SIZE * hmean) {
-        return empty;
-    }
-    let mut root = CUBE_PER_SIZE * hmax;
-    while root < extent {
-        root *= 2.0;
-    }
-    let c = [0, 1, 2].map(|k| 0.5 * (lo[k] + hi[k]));
-    let origin = c.map(|x| x - 0.5 * root);
-    let mut out = Cells {
-        origin,
-        root,
-        cells: Vec::new(),
-    };
-    let inside = Inside::new(points, faces);
+    !(depth >= (2.0 * margin + 1.0) * CUBE_PER_SIZE * hmean)
+}
+
+/// A cell on the octree's stack: its depth, its index, the faces within
+/// its margin, and whether it is known to be inside.
+type Pending = (u32, [i64; 3], Vec<u32>, bool);
+
+/// The octree walk: a cell with surface within its margin is split where
+/// a child could fit the local size; a clear cell inside is kept when the
+/// size at its corners and centre is within its band, else split when the
+/// size is smaller.
+fn walk(
+    out: &mut Cells,
+    fb: &[(P3, P3)],
+    inside: &Inside,
+    size: &(dyn Fn(P3) -> f64 + Sync),
+    hmin: f64,
+    hmax: f64,
+    margin: f64,
+) {
     let band = std::f64::consts::SQRT_2;
-    // (depth, ijk, the faces within the cell's margin, known inside)
-    let all: Vec<u32> = (0..faces.len() as u32).collect();
-    let mut stack: Vec<(u32, [i64; 3], Vec<u32>, bool)> = vec![(0, [0; 3], all, false)];
+    let all: Vec<u32> = (0..fb.len() as u32).collect();
+    let mut stack: Vec<Pending> = vec![(0, [0; 3], all, false)];
     while let Some((d, ijk, near, known_in)) = stack.pop() {
         let s = out.side(d);
         let h = s / CUBE_PER_SIZE;
@@ -127,36 +172,6 @@ pub(crate) fn blocks(
             continue;
         }
         let a = out.corner(d, ijk);
-        // Split into the children, each with the faces near it (within
-        // its margin), sorted out in one pass over this cell's.
-        let split = |stack: &mut Vec<(u32, [i64; 3], Vec<u32>, bool)>, near: &[u32], known| {
-            let (h2, m2) = (0.5 * s, opts.margin * 0.5 * s);
-            let mut lists: [Vec<u32>; 8] = Default::default();
-            for &f in near {
-                let (l, u) = fb[f as usize];
-                let mut lo_ok = [false; 3];
-                let mut hi_ok = [false; 3];
-                for k in 0..3 {
-                    lo_ok[k] = l[k] <= a[k] + h2 + m2 && u[k] >= a[k] - m2;
-                    hi_ok[k] = l[k] <= a[k] + s + m2 && u[k] >= a[k] + h2 - m2;
-                }
-                for (b, list) in lists.iter_mut().enumerate() {
-                    if (0..3).all(|k| {
-                        if (b >> k) & 1 == 1 {
-                            hi_ok[k]
-                        } else {
-                            lo_ok[k]
-                        }
-                    }) {
-                        list.push(f);
-                    }
-                }
-            }
-            for (b, list) in lists.into_iter().enumerate() {
-                let c = [0, 1, 2].map(|k| 2 * ijk[k] + ((b >> k) & 1) as i64);
-                stack.push((d + 1, c, list, known));
-            }
-        };
         if !near.is_empty() {
             // Split only where a child could fit the local size: with the
             // cell's samples all over a child's band (a quarter of slack
@@ -164,17 +179,17 @@ pub(crate) fn blocks(
             let hc = 0.5 * h * band * 1.25;
             let fine = hc >= hmax || (0..9).any(|b| size(sample(a, s, b)) <= hc);
             if fine {
-                split(&mut stack, &near, false);
+                split(&mut stack, fb, &near, false, (d, ijk, a, s), margin);
             }
             continue;
         }
         // No surface within the margin: the whole cell is in or out.
-        if !known_in && !cell_inside(&inside, a, s) {
+        if !known_in && !cell_inside(inside, a, s) {
             continue;
         }
         if h / band > hmax {
             // Larger than any size in the region: only children can fit.
-            split(&mut stack, &[], true);
+            split(&mut stack, fb, &[], true, (d, ijk, a, s), margin);
             continue;
         }
         let mut small = false;
@@ -187,14 +202,47 @@ pub(crate) fn blocks(
         if fits {
             out.cells.push((d, ijk));
         } else if small {
-            split(&mut stack, &[], true);
+            split(&mut stack, fb, &[], true, (d, ijk, a, s), margin);
         }
     }
-    separate(&mut out);
-    manifold(&mut out);
-    drop_small(&mut out, opts.min_cells);
-    out.cells.sort_unstable();
-    out
+}
+
+/// Push cell `(d, ijk)` (corner `a`, side `s`)'s eight children, each with
+/// the faces of `near` within its margin, sorted out in one pass.
+fn split(
+    stack: &mut Vec<Pending>,
+    fb: &[(P3, P3)],
+    near: &[u32],
+    known: bool,
+    (d, ijk, a, s): (u32, [i64; 3], P3, f64),
+    margin: f64,
+) {
+    let (h2, m2) = (0.5 * s, margin * 0.5 * s);
+    let mut lists: [Vec<u32>; 8] = Default::default();
+    for &f in near {
+        let (l, u) = fb[f as usize];
+        let mut lo_ok = [false; 3];
+        let mut hi_ok = [false; 3];
+        for k in 0..3 {
+            lo_ok[k] = l[k] <= a[k] + h2 + m2 && u[k] >= a[k] - m2;
+            hi_ok[k] = l[k] <= a[k] + s + m2 && u[k] >= a[k] + h2 - m2;
+        }
+        for (b, list) in lists.iter_mut().enumerate() {
+            if (0..3).all(|k| {
+                if (b >> k) & 1 == 1 {
+                    hi_ok[k]
+                } else {
+                    lo_ok[k]
+                }
+            }) {
+                list.push(f);
+            }
+        }
+    }
+    for (b, list) in lists.into_iter().enumerate() {
+        let c = [0, 1, 2].map(|k| 2 * ijk[k] + ((b >> k) & 1) as i64);
+        stack.push((d + 1, c, list, known));
+    }
 }
 
 /// The cell's corners (`b` < 8) and centre (`b` = 8).
