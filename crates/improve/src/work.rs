@@ -255,6 +255,55 @@ impl<'m> Work<'m> {
         let region = self.m.region[old[0] as usize];
         let mut outer = std::mem::take(&mut self.outer);
         let mut link = std::mem::take(&mut self.link);
+        self.outer_faces(old, &mut outer);
+        if !self.link_faces(&outer, new, &mut link) {
+            self.outer = outer;
+            self.link = link;
+            return false;
+        }
+        let mut slots = std::mem::take(&mut self.slots);
+        self.take_slots(old, new.len(), region, &mut slots);
+        // Points of the cavity that may lose their p2t tet.
+        let mut cav = std::mem::take(&mut self.cav);
+        cav.clear();
+        for &t in old {
+            for p in self.m.tets[t as usize] {
+                if !cav.contains(&p) {
+                    cav.push(p);
+                }
+            }
+        }
+        for &t in &old[new.len().min(old.len())..] {
+            self.m.tets[t as usize] = DEAD;
+            self.q[t as usize] = f64::INFINITY;
+            for f in 0..4 {
+                self.m.neigh[4 * t as usize + f] = NO_FACE;
+            }
+            self.free.push(t);
+        }
+        self.write_new(new, region, &slots, &outer, &link);
+        // Cavity points in no new tet: point them at an outer tet.
+        for &p in &cav {
+            let t = self.p2t[p.idx()];
+            if t != u32::MAX && self.m.tets[t as usize].contains(&p) {
+                continue;
+            }
+            self.p2t[p.idx()] = outer
+                .iter()
+                .find(|o| !o.1.is_none() && o.0.contains(&p.0))
+                .map_or(u32::MAX, |o| o.1.tet().0);
+        }
+        self.outer = outer;
+        self.link = link;
+        self.slots = slots;
+        self.cav = cav;
+        true
+    }
+
+    /// The faces of the cavity `old` towards the rest of the mesh (or the
+    /// boundary), by sorted corners, with what lies across each.
+    #[inline(always)]
+    fn outer_faces(&self, old: &[u32], outer: &mut Vec<([u32; 3], FaceRef)>) {
         outer.clear();
         for &t in old {
             let v = self.m.tets[t as usize];
@@ -266,9 +315,19 @@ impl<'m> Work<'m> {
                 outer.push((key3(fl.map(|l| v[l].0)), n));
             }
         }
-        // Dry run: link[4i+g] = outer index, or 1<<31 | (4j+h) for a face of
-        // another new tet.
-        const NEWF: u32 = 1 << 31;
+    }
+
+    /// Dry run of [`Work::replace`]: `link[4i+g]` is the outer face that
+    /// face `g` of new tet `i` meets, or [`NEW_FACE`] `| 4j+h` for a face of
+    /// another new tet. False when a face pairs with none or with two, or
+    /// an outer face is left.
+    #[inline(always)]
+    fn link_faces(
+        &mut self,
+        outer: &[([u32; 3], FaceRef)],
+        new: &[[PointId; 4]],
+        link: &mut Vec<u32>,
+    ) -> bool {
         const UNSET: u32 = u32::MAX;
         link.clear();
         link.resize(4 * new.len(), UNSET);
@@ -302,8 +361,8 @@ impl<'m> Work<'m> {
                                 ok = false;
                             }
                             found = true;
-                            link[4 * i + g] = NEWF | (4 * j + h) as u32;
-                            link[4 * j + h] = NEWF | (4 * i + g) as u32;
+                            link[4 * i + g] = NEW_FACE | (4 * j + h) as u32;
+                            link[4 * j + h] = NEW_FACE | (4 * i + g) as u32;
                         }
                     }
                 }
@@ -312,15 +371,15 @@ impl<'m> Work<'m> {
         }
         ok &= used.iter().all(|&u| u);
         self.used = used;
-        if !ok {
-            self.outer = outer;
-            self.link = link;
-            return false;
-        }
-        // Slots: the old ones first, then free ones, then new ones.
-        let mut slots = std::mem::take(&mut self.slots);
+        ok
+    }
+
+    /// Slots for `n` new tets: the old ones first, then free ones, then
+    /// new ones.
+    #[inline(always)]
+    fn take_slots(&mut self, old: &[u32], n: usize, region: u32, slots: &mut Vec<u32>) {
         slots.clear();
-        for i in 0..new.len() {
+        for i in 0..n {
             let s = if i < old.len() {
                 old[i]
             } else if let Some(s) = self.free.pop() {
@@ -336,24 +395,18 @@ impl<'m> Work<'m> {
             };
             slots.push(s);
         }
-        // Points of the cavity that may lose their p2t tet.
-        let mut cav = std::mem::take(&mut self.cav);
-        cav.clear();
-        for &t in old {
-            for p in self.m.tets[t as usize] {
-                if !cav.contains(&p) {
-                    cav.push(p);
-                }
-            }
-        }
-        for &t in &old[new.len().min(old.len())..] {
-            self.m.tets[t as usize] = DEAD;
-            self.q[t as usize] = f64::INFINITY;
-            for f in 0..4 {
-                self.m.neigh[4 * t as usize + f] = NO_FACE;
-            }
-            self.free.push(t);
-        }
+    }
+
+    /// Write the new tets into their slots, linked as `link` says.
+    #[inline(always)]
+    fn write_new(
+        &mut self,
+        new: &[[PointId; 4]],
+        region: u32,
+        slots: &[u32],
+        outer: &[([u32; 3], FaceRef)],
+        link: &[u32],
+    ) {
         for (i, &s) in slots.iter().enumerate() {
             let s = s as usize;
             self.m.tets[s] = new[i];
@@ -364,8 +417,8 @@ impl<'m> Work<'m> {
             for g in 0..4 {
                 let me = FaceRef::of(parafront_mesh::TetId(s as u32), g);
                 let l = link[4 * i + g];
-                if l & NEWF != 0 {
-                    let jh = (l & !NEWF) as usize;
+                if l & NEW_FACE != 0 {
+                    let jh = (l & !NEW_FACE) as usize;
                     self.m.neigh[4 * s + g] =
                         FaceRef::of(parafront_mesh::TetId(slots[jh / 4]), jh % 4);
                 } else {
@@ -383,22 +436,6 @@ impl<'m> Work<'m> {
                 self.settled[p.idx()] = false;
             }
         }
-        // Cavity points in no new tet: point them at an outer tet.
-        for &p in &cav {
-            let t = self.p2t[p.idx()];
-            if t != u32::MAX && self.m.tets[t as usize].contains(&p) {
-                continue;
-            }
-            self.p2t[p.idx()] = outer
-                .iter()
-                .find(|o| !o.1.is_none() && o.0.contains(&p.0))
-                .map_or(u32::MAX, |o| o.1.tet().0);
-        }
-        self.outer = outer;
-        self.link = link;
-        self.slots = slots;
-        self.cav = cav;
-        true
     }
 
     /// Drops dead tets, and dead points when `drop_points`, renumbering
@@ -415,6 +452,9 @@ impl<'m> Work<'m> {
         self.dead_pt
     }
 }
+
+/// In [`Work::replace`]'s links: a face of another new tet.
+const NEW_FACE: u32 = 1 << 31;
 
 /// Drops the dead tet slots and the points marked in `dead_pt`,
 /// renumbering tets, neighbours (when built) and boundary triangles.
