@@ -16,8 +16,8 @@ pub use field::GradedField;
 
 pub use locate::{Interfaces, Locator, PartFilter};
 pub use partition::{
-    components, cut_faces, cut_fine_faces, dual_graph, imbalance, metis_kway, order_for_shift,
-    partition, rcb, shift_loads, shifted, tet_weights, Partition, Shift,
+    components, cut_faces, cut_fine_faces, imbalance, order_for_shift, partition, rcb, shift_loads,
+    shifted, tet_weights, Partition, Shift,
 };
 
 use parafront_front::{advance, Everywhere, FrontError, FrontInput, FrontOptions, SizeMode};

@@ -244,7 +244,7 @@ pub fn shift_loads(d: &Ddg, part: &[u32], left: &[u32], layers: usize, parts: us
 
 /// The DDG's dual graph in CSR form (METIS's `xadj`, `adjncy`): one vertex
 /// per tet, one edge per interior face, in tet and face order.
-pub fn dual_graph(d: &Ddg) -> (Vec<i32>, Vec<i32>) {
+pub(crate) fn dual_graph(d: &Ddg) -> (Vec<i32>, Vec<i32>) {
     let mut xadj = Vec::with_capacity(d.tets.len() + 1);
     let mut adj = Vec::with_capacity(4 * d.tets.len());
     xadj.push(0);
@@ -302,7 +302,12 @@ fn metis_weights(xs: &[f64], scale: f64) -> Vec<i32> {
 /// each DDG face; a fixed seed and one call at a time make it
 /// deterministic. Each part is kept connected when the DDG is (METIS's
 /// `CONTIG`); on any METIS error it falls back to [`rcb`].
-pub fn metis_kway(d: &Ddg, w: &[f64], h: &(dyn Fn(P3) -> f64 + Sync), parts: usize) -> Vec<u32> {
+pub(crate) fn metis_kway(
+    d: &Ddg,
+    w: &[f64],
+    h: &(dyn Fn(P3) -> f64 + Sync),
+    parts: usize,
+) -> Vec<u32> {
     let n = d.tets.len();
     if parts <= 1 || n <= parts {
         return rcb(d, w, parts);

@@ -49,7 +49,6 @@ struct Level {
 /// memory here.
 #[derive(Clone, Debug)]
 pub struct LooseGrid {
-    s0: f64,
     origin: P3,
     levels: Vec<Level>,
     cells: Vec<Vec<Entry>>,
@@ -121,7 +120,6 @@ impl LooseGrid {
             })
             .collect();
         LooseGrid {
-            s0,
             origin,
             levels,
             cells: Vec::new(),
@@ -131,11 +129,10 @@ impl LooseGrid {
         }
     }
 
+    /// Items held (the tests count them).
+    #[cfg(test)]
     pub fn len(&self) -> usize {
         self.len
-    }
-    pub fn is_empty(&self) -> bool {
-        self.len == 0
     }
 
     #[inline]
@@ -283,10 +280,6 @@ impl LooseGrid {
                 .iter()
                 .for_each(|&c| scan(&self.cells[c as usize]));
         }
-    }
-
-    pub fn finest_cell(&self) -> f64 {
-        self.s0
     }
 }
 

@@ -10,7 +10,7 @@
 //! points and whatever front a region filter left behind.
 
 mod core;
-pub mod grid;
+mod grid;
 mod quality;
 mod queue;
 
