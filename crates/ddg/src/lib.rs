@@ -105,68 +105,6 @@ pub fn graded_field(
     Ok(move |p: P3| f.size(p))
 }
 
-/// A face that more than two tets share ([`face_neighbours`]).
-#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-#[error("face {face:?} is shared by {tets} tets")]
-pub struct SharedFace {
-    /// The face's points, ascending.
-    pub face: [u32; 3],
-    /// How many tets have it.
-    pub tets: usize,
-}
-
-/// Face neighbours of `tets` in the front's convention: `neigh[4t+f]` is
-/// `4t'+f'` for the tet across face `f` (the face opposite corner `f`),
-/// `u32::MAX` on the boundary. Fails on a face shared by more than two
-/// tets.
-pub fn face_neighbours(tets: &[[u32; 4]]) -> Result<Vec<u32>, SharedFace> {
-    use rayon::prelude::*;
-    let mut faces: Vec<([u32; 3], u32)> = tets
-        .par_iter()
-        .enumerate()
-        .flat_map_iter(|(t, tv)| {
-            (0..4).map(move |f| {
-                let mut k = [0u32; 3];
-                let mut n = 0;
-                for (i, &p) in tv.iter().enumerate() {
-                    if i != f {
-                        k[n] = p;
-                        n += 1;
-                    }
-                }
-                k.sort_unstable();
-                (k, 4 * t as u32 + f as u32)
-            })
-        })
-        .collect();
-    // Keys and slots are unique pairs: the order does not depend on the
-    // sort, nor on the threads.
-    faces.par_sort_unstable();
-    let mut neigh = vec![u32::MAX; 4 * tets.len()];
-    let mut i = 0;
-    while i < faces.len() {
-        let mut j = i + 1;
-        while j < faces.len() && faces[j].0 == faces[i].0 {
-            j += 1;
-        }
-        match j - i {
-            1 => {}
-            2 => {
-                let (a, b) = (faces[i].1, faces[i + 1].1);
-                neigh[a as usize] = b;
-                neigh[b as usize] = a;
-            }
-            n => {
-                return Err(SharedFace {
-                    face: faces[i].0,
-                    tets: n,
-                })
-            }
-        }
-        i = j;
-    }
-    Ok(neigh)
-}
 
 impl Ddg {
     /// The corners of tet `t`.

@@ -73,76 +73,7 @@ impl TetMesh {
     /// tets, or two tets see a face from the same side.
     pub fn build_adjacency(&mut self) -> Result<(), TopoError> {
         self.neigh.clear();
-        let n = self.tets.len();
-        if n > MAX_TETS {
-            return Err(TopoError::TooManyTets { n });
-        }
-        if let Some(t) = self.tets.par_iter().position_first(has_repeat) {
-            let verts = self.tets[t];
-            let point = (0..4)
-                .find_map(|i| (0..i).find(|&j| verts[j] == verts[i]).map(|j| verts[j]))
-                .unwrap_or_default();
-            return Err(TopoError::RepeatedVertex {
-                tet: TetId::new(t),
-                point,
-                verts,
-            });
-        }
-        let keys = face_keys(&self.tets);
-        let neigh: Vec<AtomicU32> = (0..4 * n)
-            .into_par_iter()
-            .map(|_| AtomicU32::new(NO_FACE.0))
-            .collect();
-        let bad = AtomicUsize::new(0);
-        let tets = &self.tets;
-        // First bad group of each chunk; chunks are in key order, so the
-        // reported one is the same on every run.
-        let first_bad: Option<TopoError> = group_chunks(&keys)
-            .par_iter()
-            .map(|chunk| {
-                let mut first = None;
-                for_each_group(chunk, |g| match g.len() {
-                    1 => {}
-                    2 => {
-                        let (a, b) = (low(g[0]), low(g[1]));
-                        if face_parity(tets, a) == face_parity(tets, b) {
-                            bad.fetch_add(1, Relaxed);
-                            first.get_or_insert_with(|| TopoError::FaceSameSide {
-                                face: unpack_triple(g[0]).map(PointId),
-                                tets: [FaceRef(a).tet(), FaceRef(b).tet()],
-                                more: 0,
-                            });
-                        } else {
-                            neigh[a as usize].store(b, Relaxed);
-                            neigh[b as usize].store(a, Relaxed);
-                        }
-                    }
-                    _ => {
-                        bad.fetch_add(1, Relaxed);
-                        first.get_or_insert_with(|| TopoError::FaceInManyTets {
-                            face: unpack_triple(g[0]).map(PointId),
-                            tets: g.iter().map(|&k| FaceRef(low(k)).tet()).collect(),
-                            more: 0,
-                        });
-                    }
-                });
-                first
-            })
-            .collect::<Vec<_>>()
-            .into_iter()
-            .flatten()
-            .next();
-        if let Some(mut e) = first_bad {
-            let others = bad.into_inner() - 1;
-            match &mut e {
-                TopoError::FaceInManyTets { more, .. } | TopoError::FaceSameSide { more, .. } => {
-                    *more = others
-                }
-                _ => {}
-            }
-            return Err(e);
-        }
-        self.neigh = neigh.into_iter().map(|a| FaceRef(a.into_inner())).collect();
+        self.neigh = face_neighbours(&self.tets)?;
         Ok(())
     }
 
@@ -187,4 +118,82 @@ impl TetMesh {
         let t = &self.tets[f.tet().idx()];
         TET_FACES[f.local()].map(|l| t[l])
     }
+}
+
+/// The face neighbours of `tets`: faces with the same three vertices are
+/// paired (`4t+f` across face `f`, the face opposite corner `f`), faces
+/// found once get [`NO_FACE`]. Fails when a tet repeats a vertex, a face
+/// belongs to three or more tets, or two tets see a face from the same
+/// side. The one adjacency builder of the workspace: the mesh's and the
+/// merged DDG's.
+pub fn face_neighbours(tets: &[[PointId; 4]]) -> Result<Vec<FaceRef>, TopoError> {
+    let n = tets.len();
+    if n > MAX_TETS {
+        return Err(TopoError::TooManyTets { n });
+    }
+    if let Some(t) = tets.par_iter().position_first(has_repeat) {
+        let verts = tets[t];
+        let point = (0..4)
+            .find_map(|i| (0..i).find(|&j| verts[j] == verts[i]).map(|j| verts[j]))
+            .unwrap_or_default();
+        return Err(TopoError::RepeatedVertex {
+            tet: TetId::new(t),
+            point,
+            verts,
+        });
+    }
+    let keys = face_keys(tets);
+    let neigh: Vec<AtomicU32> = (0..4 * n)
+        .into_par_iter()
+        .map(|_| AtomicU32::new(NO_FACE.0))
+        .collect();
+    let bad = AtomicUsize::new(0);
+    // First bad group of each chunk; chunks are in key order, so the
+    // reported one is the same on every run.
+    let first_bad: Option<TopoError> = group_chunks(&keys)
+        .par_iter()
+        .map(|chunk| {
+            let mut first = None;
+            for_each_group(chunk, |g| match g.len() {
+                1 => {}
+                2 => {
+                    let (a, b) = (low(g[0]), low(g[1]));
+                    if face_parity(tets, a) == face_parity(tets, b) {
+                        bad.fetch_add(1, Relaxed);
+                        first.get_or_insert_with(|| TopoError::FaceSameSide {
+                            face: unpack_triple(g[0]).map(PointId),
+                            tets: [FaceRef(a).tet(), FaceRef(b).tet()],
+                            more: 0,
+                        });
+                    } else {
+                        neigh[a as usize].store(b, Relaxed);
+                        neigh[b as usize].store(a, Relaxed);
+                    }
+                }
+                _ => {
+                    bad.fetch_add(1, Relaxed);
+                    first.get_or_insert_with(|| TopoError::FaceInManyTets {
+                        face: unpack_triple(g[0]).map(PointId),
+                        tets: g.iter().map(|&k| FaceRef(low(k)).tet()).collect(),
+                        more: 0,
+                    });
+                }
+            });
+            first
+        })
+        .collect::<Vec<_>>()
+        .into_iter()
+        .flatten()
+        .next();
+    if let Some(mut e) = first_bad {
+        let others = bad.into_inner() - 1;
+        match &mut e {
+            TopoError::FaceInManyTets { more, .. } | TopoError::FaceSameSide { more, .. } => {
+                *more = others
+            }
+            _ => {}
+        }
+        return Err(e);
+    }
+    Ok(neigh.into_iter().map(|a| FaceRef(a.into_inner())).collect())
 }

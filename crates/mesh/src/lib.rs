@@ -24,7 +24,7 @@ mod problem;
 pub mod quality;
 mod tetmesh;
 
-pub use adjacency::{TopoError, MAX_TETS};
+pub use adjacency::{face_neighbours, TopoError, MAX_TETS};
 pub use check::{CheckStats, SAMPLES, VOLUME_RTOL};
 pub use ids::{FaceRef, PointId, TetId, NO_FACE};
 pub use problem::{CheckError, MeshProblem, ProblemKind};

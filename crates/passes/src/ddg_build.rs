@@ -15,6 +15,7 @@ use parafront_comm::Comm;
 use parafront_ddg::{self as ddg, Ddg};
 use parafront_front::RegionFilter;
 use parafront_geom::{cross, dist, dot, norm, sub, Aabb, P3};
+use parafront_mesh::PointId;
 use std::time::Instant;
 
 /// What building the DDG did, pass by pass.
@@ -451,7 +452,13 @@ pub(crate) fn build_ddg_at<C: Comm>(
     for t in &mut tets {
         *t = t.map(|g| map[g as usize]);
     }
-    let neigh = ddg::face_neighbours(&tets).map_err(PassError::DdgMerge)?;
+    let typed: Vec<[PointId; 4]> = tets.iter().map(|t| t.map(PointId)).collect();
+    let neigh: Vec<u32> = parafront_mesh::face_neighbours(&typed)
+        .map_err(PassError::DdgMerge)?
+        .into_iter()
+        .map(|f| f.0)
+        .collect();
+    drop(typed);
     st.merge_seconds = t0.elapsed().as_secs_f64();
     Ok((
         Ddg {

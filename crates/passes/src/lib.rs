@@ -119,9 +119,10 @@ pub enum PassError {
         /// The global id.
         point: u32,
     },
-    /// The DDG's passes left a face in more than two tets.
+    /// The DDG's passes left a face in more than two tets, or two tets
+    /// on one side of a face.
     #[error("the DDG built in parallel: {0}")]
-    DdgMerge(#[source] ddg::SharedFace),
+    DdgMerge(#[source] parafront_mesh::TopoError),
     /// Passes 1 to 3 left most of the region to the serial pass 4: a thin
     /// part, whose DDG has little interior to split.
     #[error(
