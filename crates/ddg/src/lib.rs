@@ -105,7 +105,6 @@ pub fn graded_field(
     Ok(move |p: P3| f.size(p))
 }
 
-
 impl Ddg {
     /// The corners of tet `t`.
     pub fn tet_points(&self, t: usize) -> [P3; 4] {

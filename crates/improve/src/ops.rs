@@ -195,11 +195,7 @@ impl Work<'_> {
             return Outcome::Constrained;
         }
         let n = s.ring.len();
-        let qold = s
-            .tets
-            .iter()
-            .map(|&t| self.q[t as usize])
-            .fold(f64::INFINITY, f64::min);
+        let qold = self.ball_qmin(&s.tets);
         const N: usize = MAX_RING;
         s.tq.clear();
         s.tq.resize(N * N * N, f64::NAN);
@@ -335,11 +331,7 @@ impl Work<'_> {
                 }
             }
         }
-        let qold = s
-            .ball
-            .iter()
-            .map(|&t| self.q[t as usize])
-            .fold(f64::INFINITY, f64::min);
+        let qold = self.ball_qmin(&s.ball);
         c.new.clear();
         let mut qmin = f64::INFINITY;
         for &t in &s.ball {
@@ -376,13 +368,7 @@ impl Work<'_> {
         let mut qmin = f64::INFINITY;
         let mut sum = 0.0;
         for &t in ball {
-            let v = self.m.tets[t as usize];
-            let mut x = self.pts(v);
-            for k in 0..4 {
-                if v[k] == p {
-                    x[k] = pos;
-                }
-            }
+            let x = self.pts_moved(t, p, pos);
             let Some(q) = positive_quality(x) else {
                 return BallQ::Inverted;
             };
@@ -510,10 +496,7 @@ impl Work<'_> {
         }
         let mut ball = std::mem::take(&mut s.ball);
         self.ball(p, &mut ball);
-        let qmin = ball
-            .iter()
-            .map(|&t| self.q[t as usize])
-            .fold(f64::INFINITY, f64::min);
+        let qmin = self.ball_qmin(&ball);
         let out = match self.ball_quality_above(p, pos, &ball, qmin) {
             BallQ::Inverted => Outcome::Inverted,
             BallQ::Below => Outcome::NotBetter,
@@ -537,10 +520,7 @@ impl Work<'_> {
         let mut ball = std::mem::take(&mut s.ball);
         self.ball(p, &mut ball);
         self.neighbours(p, &ball, &mut s.nb);
-        let qmin = ball
-            .iter()
-            .map(|&t| self.q[t as usize])
-            .fold(f64::INFINITY, f64::min);
+        let qmin = self.ball_qmin(&ball);
         let p0 = self.m.points[p.idx()];
         let mean0 = ball.iter().map(|&t| self.q[t as usize]).sum::<f64>() / ball.len() as f64;
         let mut best: Option<(f64, P3)> = None;
@@ -582,24 +562,14 @@ impl Work<'_> {
         let mut ball = std::mem::take(&mut s.ball);
         self.ball(p, &mut ball);
         self.neighbours(p, &ball, &mut s.nb);
-        let floor = keep
-            * ball
-                .iter()
-                .map(|&t| self.q[t as usize])
-                .fold(f64::INFINITY, f64::min);
+        let floor = keep * self.ball_qmin(&ball);
         // (min dihedral, tets under 10°) of the ball with p at pos, when no
         // tet inverts or falls under the mean ratio floor.
         let eval = |w: &Self, pos: P3| -> Option<(f64, usize)> {
             let mut d = f64::INFINITY;
             let mut under = 0;
             for &t in &ball {
-                let v = w.m.tets[t as usize];
-                let mut x = w.pts(v);
-                for k in 0..4 {
-                    if v[k] == p {
-                        x[k] = pos;
-                    }
-                }
+                let x = w.pts_moved(t, p, pos);
                 if positive_quality(x).is_none_or(|q| q < floor) {
                     return None;
                 }
@@ -656,13 +626,7 @@ impl Work<'_> {
         let eval = |w: &Self, pos: P3, cap: usize, floor: f64| -> Option<(usize, f64, f64)> {
             let (mut under, mut short, mut dmin) = (0, 0.0, f64::INFINITY);
             for &t in &ball {
-                let v = w.m.tets[t as usize];
-                let mut x = w.pts(v);
-                for k in 0..4 {
-                    if v[k] == p {
-                        x[k] = pos;
-                    }
-                }
+                let x = w.pts_moved(t, p, pos);
                 let d = min_dihedral_deg(x);
                 under += usize::from(d < crate::insert::SMALL_DIHEDRAL);
                 if under > cap || d < floor || !positive(x) {

@@ -133,6 +133,27 @@ impl<'m> Work<'m> {
         v.map(|p| self.m.points[p.idx()])
     }
 
+    /// Tet `t`'s corners with point `p` at `pos` (a move being weighed).
+    #[inline(always)]
+    pub(crate) fn pts_moved(&self, t: u32, p: PointId, pos: P3) -> [P3; 4] {
+        let v = self.m.tets[t as usize];
+        let mut x = self.pts(v);
+        for k in 0..4 {
+            if v[k] == p {
+                x[k] = pos;
+            }
+        }
+        x
+    }
+
+    /// The worst quality of the tets `ball` (any list of live tets).
+    #[inline]
+    pub(crate) fn ball_qmin(&self, ball: &[u32]) -> f64 {
+        ball.iter()
+            .map(|&t| self.q[t as usize])
+            .fold(f64::INFINITY, f64::min)
+    }
+
     #[inline]
     pub fn alive(&self, t: u32) -> bool {
         self.m.tets[t as usize][0] != DEAD[0]
