@@ -420,27 +420,7 @@ impl File<'_> {
 /// Reads a `.vtu` file into a tet mesh.
 pub fn read_vtu(path: &Path, bytes: &[u8]) -> Result<TetMesh, IoError> {
     let cx = Ctx { path };
-    // Split at <AppendedData: the raw bytes after it are not text.
-    let (xml_end, appended, appended_b64) = match find(bytes, b"<AppendedData") {
-        Some(a) => {
-            let gt = find(&bytes[a..], b">")
-                .ok_or_else(|| cx.err("unterminated <AppendedData> tag"))?
-                + a;
-            let tag = String::from_utf8_lossy(&bytes[a..gt]);
-            let b64 = tag.contains("base64");
-            let us = find(&bytes[gt..], b"_")
-                .ok_or_else(|| cx.err("appended data lacks its leading '_'"))?
-                + gt;
-            let mut data = &bytes[us + 1..];
-            if b64 {
-                // Base64 stops at the closing tag.
-                let e = find(data, b"<").unwrap_or(data.len());
-                data = &data[..e];
-            }
-            (a, data, b64)
-        }
-        None => (bytes.len(), &bytes[..0], false),
-    };
+    let (xml_end, appended, appended_b64) = split_appended(&cx, bytes)?;
     let text =
         std::str::from_utf8(&bytes[..xml_end]).map_err(|_| cx.err("XML part is not UTF-8"))?;
     let root = parse_xml(&cx, text)?;
@@ -490,130 +470,177 @@ pub fn read_vtu(path: &Path, bytes: &[u8]) -> Result<TetMesh, IoError> {
         let (np, nc) = (count("NumberOfPoints")?, count("NumberOfCells")?);
         let base = m.points.len();
         if np > 0 {
-            let da = piece
-                .kid("Points")
-                .and_then(|p| p.kid("DataArray"))
-                .ok_or_else(|| cx.err(format!("piece {pi}: no <Points> array")))?;
-            let ncomp = da.attr("NumberOfComponents").unwrap_or("1");
-            if ncomp != "3" {
-                return Err(cx.err(format!(
-                    "piece {pi}: points have {ncomp} components, expected 3"
-                )));
-            }
-            let p = f.read(da)?.floats();
-            if p.len() != 3 * np {
-                return Err(cx.err(format!(
-                    "piece {pi}: {} point coordinates for {np} points",
-                    p.len()
-                )));
-            }
-            if let Some(k) = p.iter().position(|x| !x.is_finite()) {
-                return Err(cx.err(format!(
-                    "piece {pi}: point {} has a non-finite coordinate",
-                    k / 3
-                )));
-            }
-            if base + np > u32::MAX as usize {
-                return Err(cx.err("more points than 32-bit ids hold"));
-            }
-            m.points
-                .extend(p.chunks_exact(3).map(|c| [c[0], c[1], c[2]]));
+            read_points(&f, pi, piece, np, &mut m)?;
         }
         if nc == 0 {
             continue;
         }
-        let cells = piece
-            .kid("Cells")
-            .ok_or_else(|| cx.err(format!("piece {pi}: no <Cells>")))?;
-        let mut arr: HashMap<&str, &El> = HashMap::new();
-        for da in cells.kids.iter().filter(|k| k.name == "DataArray") {
-            arr.insert(da.attr("Name").unwrap_or(""), da);
-        }
-        let get = |n: &str| -> Result<Vec<i64>, IoError> {
-            let da = arr
-                .get(n)
-                .ok_or_else(|| cx.err(format!("piece {pi}: no {n:?} array in <Cells>")))?;
-            f.read(da)?.ints(cx, n)
-        };
-        let (conn, offs, types) = (get("connectivity")?, get("offsets")?, get("types")?);
-        if offs.len() != nc || types.len() != nc {
-            return Err(cx.err(format!(
-                "piece {pi}: {} offsets and {} types for {nc} cells",
-                offs.len(),
-                types.len()
-            )));
-        }
-        let mut cdata: HashMap<&str, &El> = HashMap::new();
-        if let Some(cd) = piece.kid("CellData") {
-            for da in cd.kids.iter().filter(|k| k.name == "DataArray") {
-                cdata.insert(da.attr("Name").unwrap_or(""), da);
-            }
-        }
-        let tag_array = |keys: &[&str]| -> Result<Option<Vec<i64>>, IoError> {
-            for k in keys {
-                if let Some(da) = cdata.get(k) {
-                    let v = f.read(da)?;
-                    if v.len() != nc {
-                        return Err(cx.err(format!(
-                            "piece {pi}: cell array {k:?} has {} values for {nc} cells",
-                            v.len()
-                        )));
-                    }
-                    return v.ints(cx, k).map(Some);
-                }
-            }
-            Ok(None)
-        };
-        let region = tag_array(&REGION_KEYS)?;
-        let patch = match tag_array(&["patch"])? {
-            Some(p) => Some(p),
-            None => region.clone(),
-        };
-        let tag = |v: &Option<Vec<i64>>, c: usize, what: &str| -> Result<u32, IoError> {
-            let t = v.as_ref().map_or(0, |v| v[c]);
-            u32::try_from(t)
-                .map_err(|_| cx.err(format!("piece {pi}: cell {c} has {what} {t}, not a u32")))
-        };
-        let mut start = 0i64;
-        for c in 0..nc {
-            let end = offs[c];
-            if end < start || end as u64 > conn.len() as u64 {
-                return Err(cx.err(format!("piece {pi}: cell {c} has bad offset {end}")));
-            }
-            let ids = &conn[start as usize..end as usize];
-            start = end;
-            let pid = |k: usize| -> Result<PointId, IoError> {
-                let v = ids[k];
-                if v < 0 || v as u64 >= np as u64 {
-                    return Err(cx.err(format!("piece {pi}: cell {c} refers to point {v} of {np}")));
-                }
-                Ok(PointId((base + v as usize) as u32))
-            };
-            let ty = types[c];
-            let want = match ty {
-                10 => 4,
-                5 => 3,
-                1..=4 => continue,
-                t => {
-                    return Err(cx.err(format!("piece {pi}: cell {c} has unsupported VTK type {t}")))
-                }
-            };
-            if ids.len() != want {
-                return Err(cx.err(format!(
-                    "piece {pi}: cell {c} of type {ty} has {} points",
-                    ids.len()
-                )));
-            }
-            if ty == 10 {
-                m.tets.push([pid(0)?, pid(1)?, pid(2)?, pid(3)?]);
-                m.region.push(tag(&region, c, "region")?);
-            } else {
-                m.bnd_tris.push([pid(0)?, pid(1)?, pid(2)?]);
-                m.bnd_patch.push(tag(&patch, c, "patch")?);
-            }
-        }
+        read_cells(&f, pi, piece, np, nc, base, &mut m)?;
     }
     Ok(m)
+}
+
+/// Where the XML ends, and the appended data after its `_` (and whether
+/// it is base64): split at `<AppendedData`, whose raw bytes are not text.
+fn split_appended<'a>(cx: &Ctx, bytes: &'a [u8]) -> Result<(usize, &'a [u8], bool), IoError> {
+    Ok(match find(bytes, b"<AppendedData") {
+        Some(a) => {
+            let gt = find(&bytes[a..], b">")
+                .ok_or_else(|| cx.err("unterminated <AppendedData> tag"))?
+                + a;
+            let tag = String::from_utf8_lossy(&bytes[a..gt]);
+            let b64 = tag.contains("base64");
+            let us = find(&bytes[gt..], b"_")
+                .ok_or_else(|| cx.err("appended data lacks its leading '_'"))?
+                + gt;
+            let mut data = &bytes[us + 1..];
+            if b64 {
+                // Base64 stops at the closing tag.
+                let e = find(data, b"<").unwrap_or(data.len());
+                data = &data[..e];
+            }
+            (a, data, b64)
+        }
+        None => (bytes.len(), &bytes[..0], false),
+    })
+}
+
+/// Piece `pi`'s `np` points, appended to `m`'s.
+fn read_points(f: &File, pi: usize, piece: &El, np: usize, m: &mut TetMesh) -> Result<(), IoError> {
+    let cx = &f.cx;
+    let base = m.points.len();
+    let da = piece
+        .kid("Points")
+        .and_then(|p| p.kid("DataArray"))
+        .ok_or_else(|| cx.err(format!("piece {pi}: no <Points> array")))?;
+    let ncomp = da.attr("NumberOfComponents").unwrap_or("1");
+    if ncomp != "3" {
+        return Err(cx.err(format!(
+            "piece {pi}: points have {ncomp} components, expected 3"
+        )));
+    }
+    let p = f.read(da)?.floats();
+    if p.len() != 3 * np {
+        return Err(cx.err(format!(
+            "piece {pi}: {} point coordinates for {np} points",
+            p.len()
+        )));
+    }
+    if let Some(k) = p.iter().position(|x| !x.is_finite()) {
+        return Err(cx.err(format!(
+            "piece {pi}: point {} has a non-finite coordinate",
+            k / 3
+        )));
+    }
+    if base + np > u32::MAX as usize {
+        return Err(cx.err("more points than 32-bit ids hold"));
+    }
+    m.points
+        .extend(p.chunks_exact(3).map(|c| [c[0], c[1], c[2]]));
+    Ok(())
+}
+
+/// Piece `pi`'s `nc` cells: tets with their regions, triangles with
+/// their patches; its points start at `base`.
+fn read_cells(
+    f: &File,
+    pi: usize,
+    piece: &El,
+    np: usize,
+    nc: usize,
+    base: usize,
+    m: &mut TetMesh,
+) -> Result<(), IoError> {
+    let cx = &f.cx;
+    let cells = piece
+        .kid("Cells")
+        .ok_or_else(|| cx.err(format!("piece {pi}: no <Cells>")))?;
+    let mut arr: HashMap<&str, &El> = HashMap::new();
+    for da in cells.kids.iter().filter(|k| k.name == "DataArray") {
+        arr.insert(da.attr("Name").unwrap_or(""), da);
+    }
+    let get = |n: &str| -> Result<Vec<i64>, IoError> {
+        let da = arr
+            .get(n)
+            .ok_or_else(|| cx.err(format!("piece {pi}: no {n:?} array in <Cells>")))?;
+        f.read(da)?.ints(cx, n)
+    };
+    let (conn, offs, types) = (get("connectivity")?, get("offsets")?, get("types")?);
+    if offs.len() != nc || types.len() != nc {
+        return Err(cx.err(format!(
+            "piece {pi}: {} offsets and {} types for {nc} cells",
+            offs.len(),
+            types.len()
+        )));
+    }
+    let mut cdata: HashMap<&str, &El> = HashMap::new();
+    if let Some(cd) = piece.kid("CellData") {
+        for da in cd.kids.iter().filter(|k| k.name == "DataArray") {
+            cdata.insert(da.attr("Name").unwrap_or(""), da);
+        }
+    }
+    let tag_array = |keys: &[&str]| -> Result<Option<Vec<i64>>, IoError> {
+        for k in keys {
+            if let Some(da) = cdata.get(k) {
+                let v = f.read(da)?;
+                if v.len() != nc {
+                    return Err(cx.err(format!(
+                        "piece {pi}: cell array {k:?} has {} values for {nc} cells",
+                        v.len()
+                    )));
+                }
+                return v.ints(cx, k).map(Some);
+            }
+        }
+        Ok(None)
+    };
+    let region = tag_array(&REGION_KEYS)?;
+    let patch = match tag_array(&["patch"])? {
+        Some(p) => Some(p),
+        None => region.clone(),
+    };
+    let tag = |v: &Option<Vec<i64>>, c: usize, what: &str| -> Result<u32, IoError> {
+        let t = v.as_ref().map_or(0, |v| v[c]);
+        u32::try_from(t)
+            .map_err(|_| cx.err(format!("piece {pi}: cell {c} has {what} {t}, not a u32")))
+    };
+    let mut start = 0i64;
+    for c in 0..nc {
+        let end = offs[c];
+        if end < start || end as u64 > conn.len() as u64 {
+            return Err(cx.err(format!("piece {pi}: cell {c} has bad offset {end}")));
+        }
+        let ids = &conn[start as usize..end as usize];
+        start = end;
+        let pid = |k: usize| -> Result<PointId, IoError> {
+            let v = ids[k];
+            if v < 0 || v as u64 >= np as u64 {
+                return Err(cx.err(format!("piece {pi}: cell {c} refers to point {v} of {np}")));
+            }
+            Ok(PointId((base + v as usize) as u32))
+        };
+        let ty = types[c];
+        let want = match ty {
+            10 => 4,
+            5 => 3,
+            1..=4 => continue,
+            t => return Err(cx.err(format!("piece {pi}: cell {c} has unsupported VTK type {t}"))),
+        };
+        if ids.len() != want {
+            return Err(cx.err(format!(
+                "piece {pi}: cell {c} of type {ty} has {} points",
+                ids.len()
+            )));
+        }
+        if ty == 10 {
+            m.tets.push([pid(0)?, pid(1)?, pid(2)?, pid(3)?]);
+            m.region.push(tag(&region, c, "region")?);
+        } else {
+            m.bnd_tris.push([pid(0)?, pid(1)?, pid(2)?]);
+            m.bnd_patch.push(tag(&patch, c, "patch")?);
+        }
+    }
+    Ok(())
 }
 
 fn find(h: &[u8], n: &[u8]) -> Option<usize> {
