@@ -40,6 +40,9 @@ fn key(p: P3) -> Key {
     p.map(|x| (x + 0.0).to_bits())
 }
 
+/// A piece with its points' exact keys (for the shared lists).
+type Keyed = (Piece, FxHashMap<Key, u32>);
+
 struct TetMsg {
     v: [(u32, P3); 4],
     pass: u8,
@@ -53,9 +56,32 @@ pub(crate) fn run<C: Comm>(
     input: &[P3],
     n_gid: u32,
 ) -> Result<ParOutput, PassError> {
-    let np = parts.len();
     // Each tet to the lowest part among its points' DDG hosts.
-    let out: Vec<Vec<(u32, TetMsg)>> = parts
+    let inbox = comm.exchange(send_tets(parts, loc, part0));
+    // Each part: its points once, by exact key.
+    let mut pieces = receive_tets(inbox)?;
+    number_tets(comm, &mut pieces);
+    // Send/receive lists: box overlap, then exact keys.
+    share_points(comm, &mut pieces);
+    let mut pieces: Vec<Piece> = pieces.into_iter().map(|p| p.0).collect();
+    // Global point numbers: the ids still in use, densely (tets removed
+    // for pass 4 may have left points behind), input points first.
+    let n = number_points(comm, &mut pieces, input.len(), n_gid);
+    // The merged mesh (what part 0 would gather for a single-file output).
+    let (points, tets, tet_pass) = merge(&pieces, input, n)?;
+    Ok(ParOutput {
+        points,
+        tets,
+        tet_pass,
+        pieces,
+        stats: Default::default(),
+    })
+}
+
+/// Each part's tets, addressed to the lowest part among their points' DDG
+/// hosts.
+fn send_tets(parts: Vec<Part>, loc: &Locator, part0: &[u32]) -> Vec<Vec<(u32, TetMsg)>> {
+    parts
         .into_par_iter()
         .enumerate()
         .map(|(k, part)| {
@@ -83,11 +109,13 @@ pub(crate) fn run<C: Comm>(
             }
             out
         })
-        .collect();
-    let inbox = comm.exchange(out);
+        .collect()
+}
 
-    // Each part: its points once, by exact key.
-    let mut pieces: Vec<(Piece, FxHashMap<Key, u32>)> = inbox
+/// Each part's received tets as a piece, its points once by exact key
+/// (with the key map, for the shared lists).
+fn receive_tets(inbox: Vec<Vec<(u32, TetMsg)>>) -> Result<Vec<Keyed>, PassError> {
+    inbox
         .into_par_iter()
         .map(|msgs| {
             let mut pc = Piece::default();
@@ -114,17 +142,22 @@ pub(crate) fn run<C: Comm>(
             }
             Ok((pc, map))
         })
-        .collect::<Result<_, PassError>>()?;
+        .collect::<Result<_, PassError>>()
+}
 
-    // Global tet numbers: by part, then local order.
+/// Global tet numbers: by part, then local order.
+fn number_tets<C: Comm>(comm: &C, pieces: &mut [Keyed]) {
     let counts = comm.all_gather(pieces.iter().map(|p| p.0.tets.len() as u32).collect());
     let mut base = 0u32;
     for (k, (pc, _)) in pieces.iter_mut().enumerate() {
         pc.tet_gid = (base..base + counts[k]).collect();
         base += counts[k];
     }
+}
 
-    // Send/receive lists: box overlap, then exact keys.
+/// Each piece's neighbours and shared points (the send/receive lists),
+/// and each point's owner: the lowest part that holds it.
+fn share_points<C: Comm>(comm: &C, pieces: &mut [Keyed]) {
     let boxes = comm.all_gather(
         pieces
             .iter()
@@ -173,12 +206,12 @@ pub(crate) fn run<C: Comm>(
                 pc.shared.push(sh);
             }
         });
-    let pieces: Vec<Piece> = pieces.into_iter().map(|p| p.0).collect();
+}
 
-    // Global point numbers: the ids still in use, densely (tets removed
-    // for pass 4 may have left points behind), input points first.
+/// Renumber the pieces' global point ids densely; the count.
+fn number_points<C: Comm>(comm: &C, pieces: &mut [Piece], n_input: usize, n_gid: u32) -> u32 {
     let mut used = vec![false; n_gid as usize];
-    used[..input.len()].fill(true);
+    used[..n_input].fill(true);
     for ids in comm.all_gather(pieces.iter().map(|p| p.gid.clone()).collect()) {
         for g in ids {
             used[g as usize] = true;
@@ -192,21 +225,28 @@ pub(crate) fn run<C: Comm>(
             n += 1;
         }
     }
-    let mut pieces = pieces;
-    for pc in &mut pieces {
+    for pc in pieces.iter_mut() {
         for g in &mut pc.gid {
             *g = renum[*g as usize];
         }
     }
+    n
+}
 
-    // The merged mesh (what part 0 would gather for a single-file output).
+/// The merged mesh: every point, every tet, and the pass that made it.
+#[allow(clippy::type_complexity)]
+fn merge(
+    pieces: &[Piece],
+    input: &[P3],
+    n: u32,
+) -> Result<(Vec<P3>, Vec<[u32; 4]>, Vec<u8>), PassError> {
     let mut points = vec![[f64::NAN; 3]; n as usize];
     points[..input.len()].copy_from_slice(input);
     let mut seen = vec![false; n as usize];
     seen[..input.len()].fill(true);
     let mut tets = Vec::new();
     let mut tet_pass = Vec::new();
-    for pc in &pieces {
+    for pc in pieces {
         for (i, &g) in pc.gid.iter().enumerate() {
             points[g as usize] = pc.points[i];
             seen[g as usize] = true;
@@ -217,12 +257,5 @@ pub(crate) fn run<C: Comm>(
     if let Some(g) = seen.iter().position(|&s| !s) {
         return Err(PassError::Unused { point: g as u32 });
     }
-    let _ = np;
-    Ok(ParOutput {
-        points,
-        tets,
-        tet_pass,
-        pieces,
-        stats: Default::default(),
-    })
+    Ok((points, tets, tet_pass))
 }
