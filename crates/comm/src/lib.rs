@@ -2,27 +2,53 @@
 //!
 //! Parts own their points, tets and front; they see each other's data
 //! only through the collectives of [`Comm`]. The calls are written in the
-//! bulk-synchronous form that a driver of all parts issues between two
-//! parallel phases: `out[src]` is what part `src` sends, the answer's
-//! `[dst]` is what part `dst` receives. An MPI backend implements the same
-//! trait with each rank holding only its own entry; [`Threads`] moves the
-//! buffers between parts that live in one address space.
+//! bulk-synchronous form that a driver of its parts issues between two
+//! parallel phases, with a rank-local view: a process holds the parts
+//! [`Comm::owned`] gives, passes one entry per owned part and receives one
+//! per owned part. [`Threads`] owns every part and moves the buffers
+//! between parts that live in one address space; the MPI backend
+//! (`Mpi`, feature `mpi`) gives each rank a contiguous block of parts and
+//! sends what leaves the rank as bytes ([`Wire`]).
 #![forbid(unsafe_code)]
+#![warn(missing_docs)]
 
-/// Collectives over `parts()` parts.
+use std::ops::Range;
+
+pub mod wire;
+pub use wire::{Wire, WireError};
+
+#[cfg(feature = "mpi")]
+mod mpi_backend;
+#[cfg(feature = "mpi")]
+pub use mpi_backend::{Mpi, MpiInitError};
+
+/// Collectives over `parts()` parts, of which this process holds
+/// `owned()`.
+///
+/// Every process makes the same calls in the same order (from one thread:
+/// the driver between its parallel phases). Results do not depend on the
+/// backend, on the number of processes or on timing.
 pub trait Comm: Sync {
+    /// All parts, over all processes.
     fn parts(&self) -> usize;
-    /// Point-to-point messages: `out[src]` lists `(dst, message)`. Part
-    /// `dst` receives `(src, message)` ordered by `src`, then by send order
-    /// (the order is part of the contract: results must not depend on
-    /// timing).
-    fn exchange<T: Send>(&self, out: Vec<Vec<(u32, T)>>) -> Vec<Vec<(u32, T)>>;
-    /// Every part contributes one value; every part receives all of them,
+    /// The parts this process holds, ascending: the `out` and `local`
+    /// arguments and the inboxes of [`exchange`](Comm::exchange) have one
+    /// entry per owned part, in this order. The threads backend owns all.
+    fn owned(&self) -> Range<usize>;
+    /// Point-to-point messages: `out[i]` lists `(dst, message)` sent by
+    /// part `owned().start + i`. The answer's `[i]` is what part
+    /// `owned().start + i` receives: `(src, message)` ordered by `src`,
+    /// then by send order (the order is part of the contract: results must
+    /// not depend on timing or on where the parts live).
+    fn exchange<T: Wire + Send>(&self, out: Vec<Vec<(u32, T)>>) -> Vec<Vec<(u32, T)>>;
+    /// Every owned part contributes one value (`local[i]` for part
+    /// `owned().start + i`); every process receives all parts' values,
     /// indexed by part.
-    fn all_gather<T: Clone + Send>(&self, local: Vec<T>) -> Vec<T>;
-    /// Every part contributes one value; every part receives the fold of
-    /// all of them in part order.
-    fn all_reduce<T: Clone + Send>(&self, local: Vec<T>, op: impl Fn(T, T) -> T) -> T;
+    fn all_gather<T: Wire + Clone + Send>(&self, local: Vec<T>) -> Vec<T>;
+    /// Every owned part contributes one value; every process receives the
+    /// fold of all parts' values in part order (so a float sum is the same
+    /// on every backend).
+    fn all_reduce<T: Wire + Clone + Send>(&self, local: Vec<T>, op: impl Fn(T, T) -> T) -> T;
 }
 
 /// The threads backend: parts share one address space, so a message is a
@@ -33,6 +59,7 @@ pub struct Threads {
 }
 
 impl Threads {
+    /// `parts` parts in this process.
     pub fn new(parts: usize) -> Self {
         assert!(parts > 0, "at least one part");
         Threads { parts }
@@ -44,7 +71,11 @@ impl Comm for Threads {
         self.parts
     }
 
-    fn exchange<T: Send>(&self, out: Vec<Vec<(u32, T)>>) -> Vec<Vec<(u32, T)>> {
+    fn owned(&self) -> Range<usize> {
+        0..self.parts
+    }
+
+    fn exchange<T: Wire + Send>(&self, out: Vec<Vec<(u32, T)>>) -> Vec<Vec<(u32, T)>> {
         assert_eq!(out.len(), self.parts, "one outbox per part");
         let mut inbox: Vec<Vec<(u32, T)>> = (0..self.parts).map(|_| Vec::new()).collect();
         for (src, msgs) in out.into_iter().enumerate() {
@@ -60,12 +91,12 @@ impl Comm for Threads {
         inbox
     }
 
-    fn all_gather<T: Clone + Send>(&self, local: Vec<T>) -> Vec<T> {
+    fn all_gather<T: Wire + Clone + Send>(&self, local: Vec<T>) -> Vec<T> {
         assert_eq!(local.len(), self.parts, "one value per part");
         local
     }
 
-    fn all_reduce<T: Clone + Send>(&self, local: Vec<T>, op: impl Fn(T, T) -> T) -> T {
+    fn all_reduce<T: Wire + Clone + Send>(&self, local: Vec<T>, op: impl Fn(T, T) -> T) -> T {
         assert_eq!(local.len(), self.parts, "one value per part");
         let mut it = local.into_iter();
         let first = it.next().expect("at least one part");

@@ -325,6 +325,11 @@ pub(crate) fn build_ddg_at<C: Comm>(
 ) -> Result<(Ddg, DdgBuildStats), PassError> {
     let t_all = Instant::now();
     let np = comm.parts();
+    assert_eq!(
+        comm.owned(),
+        0..np,
+        "the passes hold every part in one process"
+    );
     let mut st = DdgBuildStats::default();
     let t0 = Instant::now();
     let first = if depth >= DEEP {

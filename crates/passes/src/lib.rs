@@ -6,7 +6,10 @@
 //!
 //! Every part keeps its own points, tets and front (`Part` is private to
 //! this module and only ever touched by the closure of its own part); parts
-//! see each other's data only through the messages of a [`Comm`].
+//! see each other's data only through the messages of a [`Comm`]. The
+//! passes still hold every part in this process (`Comm::owned` is all of
+//! them, as with `Threads`); ARCHITECTURE.md says what a rank-local run
+//! under `Mpi` needs.
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
@@ -26,7 +29,7 @@ pub use ddg_build::{build_ddg, DdgBuildStats};
 pub use parafront_ddg::Partition;
 pub use redistribute::Piece;
 
-use parafront_comm::Comm;
+use parafront_comm::{Comm, Wire, WireError};
 use parafront_ddg::{self as ddg, Ddg, Interfaces, Locator, PartFilter, Shift};
 use parafront_front::{
     advance, Everywhere, FrontError, FrontInput, FrontOptions, RegionFilter, SizeMode,
@@ -267,11 +270,31 @@ struct Rec {
     h: f64,
 }
 
+impl Wire for Rec {
+    fn put(&self, buf: &mut Vec<u8>) {
+        (self.gid, self.p, self.h).put(buf);
+    }
+    fn get(buf: &mut &[u8]) -> Result<Self, WireError> {
+        let (gid, p, h) = Wire::get(buf)?;
+        Ok(Rec { gid, p, h })
+    }
+}
+
 /// A front face in a message: owned (the part advances it) or context
 /// (the part only has to know it is there).
 struct FaceMsg {
     owned: bool,
     v: [Rec; 3],
+}
+
+impl Wire for FaceMsg {
+    fn put(&self, buf: &mut Vec<u8>) {
+        (self.owned, self.v).put(buf);
+    }
+    fn get(buf: &mut &[u8]) -> Result<Self, WireError> {
+        let (owned, v) = Wire::get(buf)?;
+        Ok(FaceMsg { owned, v })
+    }
 }
 
 /// One part's local data.
@@ -398,6 +421,11 @@ pub fn mesh_parallel<C: Comm>(
     comm: &C,
 ) -> Result<ParOutput, PassError> {
     let np = comm.parts();
+    assert_eq!(
+        comm.owned(),
+        0..np,
+        "the passes hold every part in one process"
+    );
     let depth = ddg_build::depth(points, faces);
     if depth < opts.thin_depth {
         return Err(PassError::Thin { depth });

@@ -4,7 +4,7 @@
 //! learns its neighbours and the points it shares with each (bounding-box
 //! overlap first, then an exact match).
 use crate::{ParOutput, Part, PassError};
-use parafront_comm::Comm;
+use parafront_comm::{Comm, Wire, WireError};
 use parafront_ddg::Locator;
 use parafront_geom::{Aabb, P3};
 use rayon::prelude::*;
@@ -46,6 +46,16 @@ type Keyed = (Piece, FxHashMap<Key, u32>);
 struct TetMsg {
     v: [(u32, P3); 4],
     pass: u8,
+}
+
+impl Wire for TetMsg {
+    fn put(&self, buf: &mut Vec<u8>) {
+        (self.v, self.pass).put(buf);
+    }
+    fn get(buf: &mut &[u8]) -> Result<Self, WireError> {
+        let (v, pass) = Wire::get(buf)?;
+        Ok(TetMsg { v, pass })
+    }
 }
 
 pub(crate) fn run<C: Comm>(
@@ -158,12 +168,19 @@ fn number_tets<C: Comm>(comm: &C, pieces: &mut [Keyed]) {
 /// Each piece's neighbours and shared points (the send/receive lists),
 /// and each point's owner: the lowest part that holds it.
 fn share_points<C: Comm>(comm: &C, pieces: &mut [Keyed]) {
-    let boxes = comm.all_gather(
-        pieces
-            .iter()
-            .map(|p| Aabb::from_points(p.0.points.iter()))
-            .collect(),
-    );
+    let boxes: Vec<Aabb> = comm
+        .all_gather(
+            pieces
+                .iter()
+                .map(|p| {
+                    let b = Aabb::from_points(p.0.points.iter());
+                    [b.min, b.max]
+                })
+                .collect(),
+        )
+        .into_iter()
+        .map(|[min, max]| Aabb { min, max })
+        .collect();
     let out: Vec<Vec<(u32, Vec<Key>)>> = pieces
         .par_iter()
         .enumerate()
