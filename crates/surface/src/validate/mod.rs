@@ -165,34 +165,9 @@ pub fn validate(s: &Surface) -> Report {
         shells: Vec::new(),
     };
     let np = s.points.len();
-    if s.tris.is_empty() {
-        r.push(Class::NoTriangles, 1, Vec::new());
+    let Some(used) = fatal(s, &mut r) else {
         return r;
-    }
-    let bad: Vec<u32> = (0..s.tris.len() as u32)
-        .filter(|&t| s.tris[t as usize].iter().any(|&v| v as usize >= np))
-        .collect();
-    if !bad.is_empty() {
-        let ex = bad
-            .iter()
-            .take(MAX_EXAMPLES)
-            .map(|&t| Item::BadTri {
-                t,
-                v: s.tris[t as usize],
-            })
-            .collect();
-        r.push(Class::BadIndex, bad.len(), ex);
-        return r;
-    }
-    let used = topology::referenced(s);
-    let nonfinite: Vec<u32> = (0..np as u32)
-        .filter(|&v| used[v as usize] && s.points[v as usize].iter().any(|x| !x.is_finite()))
-        .collect();
-    if !nonfinite.is_empty() {
-        let ex = vertex_items(s, &nonfinite, |_| 0);
-        r.push(Class::NonFinite, nonfinite.len(), ex);
-        return r;
-    }
+    };
 
     let edges = topology::Edges::build(s);
     let (open, nonman, incons) = edges.classify(s);
@@ -213,25 +188,8 @@ pub fn validate(s: &Surface) -> Report {
 
     r.shells = shells::shells_with(s, &edges);
 
-    let tri_item = |t: u32| {
-        let v = s.tris[t as usize];
-        Item::Tri {
-            t,
-            v,
-            p: v.map(|i| s.points[i as usize]),
-        }
-    };
-    let pair_item = |a: u32, b: u32| {
-        let (va, vb) = (s.tris[a as usize], s.tris[b as usize]);
-        Item::TriPair {
-            t: [a, b],
-            v: [va, vb],
-            p: [
-                va.map(|i| s.points[i as usize]),
-                vb.map(|i| s.points[i as usize]),
-            ],
-        }
-    };
+    let tri_item = |t: u32| tri_item(s, t);
+    let pair_item = |a: u32, b: u32| pair_item(s, a, b);
 
     r.push(Class::OpenEdge, open.len(), edges.items(s, &open));
     r.push(
@@ -271,18 +229,7 @@ pub fn validate(s: &Surface) -> Report {
         n_pairs,
         pairs.iter().map(|&(a, b)| pair_item(a, b)).collect(),
     );
-    let wrong: Vec<Item> = r
-        .shells
-        .iter()
-        .enumerate()
-        .filter(|(_, sh)| !sh.orientation_ok())
-        .map(|(i, sh)| Item::Shell {
-            shell: i as u32,
-            first_tri: sh.tris[0],
-            volume: sh.volume,
-            depth: sh.depth,
-        })
-        .collect();
+    let wrong = wrong_shells(&r.shells);
     let nw = wrong.len();
     r.push(
         Class::WrongShellOrientation,
@@ -296,6 +243,80 @@ pub fn validate(s: &Surface) -> Report {
         vertex_items(s, &unused, |_| 0),
     );
     r
+}
+
+/// The defects that make every other check meaningless: no triangles,
+/// out-of-range ids, non-finite points (reported to `r`). `None` when one
+/// is found, else which points the triangles use.
+fn fatal(s: &Surface, r: &mut Report) -> Option<Vec<bool>> {
+    let np = s.points.len();
+    if s.tris.is_empty() {
+        r.push(Class::NoTriangles, 1, Vec::new());
+        return None;
+    }
+    let bad: Vec<u32> = (0..s.tris.len() as u32)
+        .filter(|&t| s.tris[t as usize].iter().any(|&v| v as usize >= np))
+        .collect();
+    if !bad.is_empty() {
+        let ex = bad
+            .iter()
+            .take(MAX_EXAMPLES)
+            .map(|&t| Item::BadTri {
+                t,
+                v: s.tris[t as usize],
+            })
+            .collect();
+        r.push(Class::BadIndex, bad.len(), ex);
+        return None;
+    }
+    let used = topology::referenced(s);
+    let nonfinite: Vec<u32> = (0..np as u32)
+        .filter(|&v| used[v as usize] && s.points[v as usize].iter().any(|x| !x.is_finite()))
+        .collect();
+    if !nonfinite.is_empty() {
+        let ex = vertex_items(s, &nonfinite, |_| 0);
+        r.push(Class::NonFinite, nonfinite.len(), ex);
+        return None;
+    }
+    Some(used)
+}
+
+/// Triangle `t` as a report item.
+fn tri_item(s: &Surface, t: u32) -> Item {
+    let v = s.tris[t as usize];
+    Item::Tri {
+        t,
+        v,
+        p: v.map(|i| s.points[i as usize]),
+    }
+}
+
+/// Triangles `a` and `b` as a report item.
+fn pair_item(s: &Surface, a: u32, b: u32) -> Item {
+    let (va, vb) = (s.tris[a as usize], s.tris[b as usize]);
+    Item::TriPair {
+        t: [a, b],
+        v: [va, vb],
+        p: [
+            va.map(|i| s.points[i as usize]),
+            vb.map(|i| s.points[i as usize]),
+        ],
+    }
+}
+
+/// The shells turned the wrong way for their depth, as report items.
+fn wrong_shells(shells: &[Shell]) -> Vec<Item> {
+    shells
+        .iter()
+        .enumerate()
+        .filter(|(_, sh)| !sh.orientation_ok())
+        .map(|(i, sh)| Item::Shell {
+            shell: i as u32,
+            first_tri: sh.tris[0],
+            volume: sh.volume,
+            depth: sh.depth,
+        })
+        .collect()
 }
 
 fn vertex_items(s: &Surface, vs: &[u32], fans: impl Fn(usize) -> u32) -> Vec<Item> {
