@@ -31,7 +31,37 @@ pub(super) fn close_pockets(
     if own.is_empty() {
         return 0;
     }
-    // Components through shared edges (union-find over faces).
+    let comp = components(&res.front, &own);
+    let mut done = vec![false; res.front.len()];
+    let mut made = 0;
+    let mut i = 0;
+    while i < comp.len() {
+        let mut j = i;
+        while j < comp.len() && comp[j].0 == comp[i].0 {
+            j += 1;
+        }
+        let faces: Vec<[u32; 3]> = comp[i..j].iter().map(|c| res.front[c.1]).collect();
+        if is_pocket(res, &faces) {
+            if let Some(n) = fill_pocket(res, &faces, size) {
+                made += n;
+                for c in &comp[i..j] {
+                    done[c.1] = true;
+                }
+            }
+        }
+        i = j;
+    }
+    let mut k = 0;
+    res.front.retain(|_| {
+        k += 1;
+        !done[k - 1]
+    });
+    made
+}
+
+/// The faces `own` of `front` in components through shared edges
+/// (union-find): `(component, face)`, sorted by component.
+fn components(front: &[[u32; 3]], own: &[usize]) -> Vec<(usize, usize)> {
     let mut up: Vec<usize> = (0..own.len()).collect();
     fn root(up: &mut [usize], mut x: usize) -> usize {
         while up[x] != x {
@@ -42,7 +72,7 @@ pub(super) fn close_pockets(
     }
     let mut edges: Vec<(u32, u32, usize)> = Vec::with_capacity(own.len() * 3);
     for (j, &f) in own.iter().enumerate() {
-        let v = res.front[f];
+        let v = front[f];
         for c in 0..3 {
             let (a, b) = (v[c], v[(c + 1) % 3]);
             edges.push((a.min(b), a.max(b), j));
@@ -60,96 +90,87 @@ pub(super) fn close_pockets(
     let mut comp: Vec<(usize, usize)> =
         (0..own.len()).map(|j| (root(&mut up, j), own[j])).collect();
     comp.sort_unstable();
-    let mut done = vec![false; res.front.len()];
-    let mut made = 0;
-    let mut i = 0;
-    while i < comp.len() {
-        let mut j = i;
-        while j < comp.len() && comp[j].0 == comp[i].0 {
-            j += 1;
+    comp
+}
+
+/// A pocket: closed on its own (every directed edge as often as its
+/// reverse), facing in (negative signed volume), small (about a tet per
+/// face, and at most [`MAX_POCKET`] faces). A large closed set may wrap
+/// another part's region, and one facing out bounds the rest of the
+/// region: both wait for the next pass.
+fn is_pocket(res: &parafront_front::FrontResult, faces: &[[u32; 3]]) -> bool {
+    let mut e: Vec<(u32, u32)> = Vec::with_capacity(faces.len() * 3);
+    for v in faces {
+        for c in 0..3 {
+            e.push((v[c], v[(c + 1) % 3]));
         }
-        let faces: Vec<[u32; 3]> = comp[i..j].iter().map(|c| res.front[c.1]).collect();
-        // Closed on its own: every directed edge as often as its reverse.
-        let mut e: Vec<(u32, u32)> = Vec::with_capacity(faces.len() * 3);
-        for v in &faces {
-            for c in 0..3 {
-                e.push((v[c], v[(c + 1) % 3]));
-            }
-        }
-        e.sort_unstable();
-        let closed = e.iter().all(|&(a, b)| {
-            let n = |x: (u32, u32)| e.partition_point(|y| *y <= x) - e.partition_point(|y| *y < x);
-            n((a, b)) == n((b, a))
-        });
-        // A large closed set is not a pocket (it may wrap another part's
-        // region); it waits for the next pass.
-        // A pocket is a small cavity: the faces point into it (negative
-        // signed volume), and it holds about a tet per face. A closed set
-        // facing out bounds the rest of the region, not a pocket.
-        let mut vol = 0.0;
-        let mut hsum = 0.0;
-        for f in &faces {
-            let [a, b, c] = f.map(|i| res.points[i as usize]);
-            vol += parafront_geom::dot(a, parafront_geom::cross(b, c)) / 6.0;
-            hsum += f.iter().map(|&i| res.point_size[i as usize]).sum::<f64>() / 3.0;
-        }
-        let hm = hsum / faces.len() as f64;
-        let pocket = vol < 0.0 && -vol <= faces.len() as f64 * hm * hm * hm;
-        if tracing::enabled!(tracing::Level::DEBUG) && closed {
-            tracing::debug!(
-                "pocket: {} faces, vol {vol:.3e}, h {hm:.3e}, taken {}",
-                faces.len(),
-                pocket && faces.len() <= MAX_POCKET
-            );
-        }
-        if closed && pocket && faces.len() <= MAX_POCKET {
-            let mut pts: Vec<u32> = faces.iter().flatten().copied().collect();
-            pts.sort_unstable();
-            pts.dedup();
-            let local = |p: u32| pts.binary_search(&p).unwrap() as u32;
-            let r = advance(
-                FrontInput {
-                    points: pts.iter().map(|&p| res.points[p as usize]).collect(),
-                    point_size: pts.iter().map(|&p| res.point_size[p as usize]).collect(),
-                    faces: faces.iter().map(|f| f.map(local)).collect(),
-                },
-                SizeMode::Field(size),
-                &Everywhere,
-                &FrontOptions {
-                    recovery_rounds: POCKET_ROUNDS,
-                    max_points: 50 * faces.len() + pts.len(),
-                    ..FrontOptions::default()
-                },
-            );
-            if let Ok(r) = r {
-                if r.front.is_empty() {
-                    let base = res.points.len() as u32;
-                    let n = pts.len();
-                    res.points.extend_from_slice(&r.points[n..]);
-                    res.point_size.extend_from_slice(&r.point_size[n..]);
-                    let map = |q: u32| {
-                        if (q as usize) < n {
-                            pts[q as usize]
-                        } else {
-                            base + q - n as u32
-                        }
-                    };
-                    res.tets.extend(r.tets.iter().map(|t| t.map(map)));
-                    made += r.tets.len();
-                    for c in &comp[i..j] {
-                        done[c.1] = true;
-                    }
-                }
-            }
-        }
-        i = j;
     }
-    let mut k = 0;
-    res.front.retain(|_| {
-        k += 1;
-        !done[k - 1]
+    e.sort_unstable();
+    let closed = e.iter().all(|&(a, b)| {
+        let n = |x: (u32, u32)| e.partition_point(|y| *y <= x) - e.partition_point(|y| *y < x);
+        n((a, b)) == n((b, a))
     });
-    made
+    let mut vol = 0.0;
+    let mut hsum = 0.0;
+    for f in faces {
+        let [a, b, c] = f.map(|i| res.points[i as usize]);
+        vol += parafront_geom::dot(a, parafront_geom::cross(b, c)) / 6.0;
+        hsum += f.iter().map(|&i| res.point_size[i as usize]).sum::<f64>() / 3.0;
+    }
+    let hm = hsum / faces.len() as f64;
+    let pocket = vol < 0.0 && -vol <= faces.len() as f64 * hm * hm * hm;
+    if tracing::enabled!(tracing::Level::DEBUG) && closed {
+        tracing::debug!(
+            "pocket: {} faces, vol {vol:.3e}, h {hm:.3e}, taken {}",
+            faces.len(),
+            pocket && faces.len() <= MAX_POCKET
+        );
+    }
+    closed && pocket && faces.len() <= MAX_POCKET
+}
+
+/// Close pocket `faces` by the front with recovery on, adding its points
+/// and tets to `res`; the tets made, or `None` when it stays open.
+fn fill_pocket(
+    res: &mut parafront_front::FrontResult,
+    faces: &[[u32; 3]],
+    size: &(dyn Fn(P3) -> f64 + Sync),
+) -> Option<usize> {
+    let mut pts: Vec<u32> = faces.iter().flatten().copied().collect();
+    pts.sort_unstable();
+    pts.dedup();
+    let local = |p: u32| pts.binary_search(&p).unwrap() as u32;
+    let r = advance(
+        FrontInput {
+            points: pts.iter().map(|&p| res.points[p as usize]).collect(),
+            point_size: pts.iter().map(|&p| res.point_size[p as usize]).collect(),
+            faces: faces.iter().map(|f| f.map(local)).collect(),
+        },
+        SizeMode::Field(size),
+        &Everywhere,
+        &FrontOptions {
+            recovery_rounds: POCKET_ROUNDS,
+            max_points: 50 * faces.len() + pts.len(),
+            ..FrontOptions::default()
+        },
+    )
+    .ok()?;
+    if !r.front.is_empty() {
+        return None;
+    }
+    let base = res.points.len() as u32;
+    let n = pts.len();
+    res.points.extend_from_slice(&r.points[n..]);
+    res.point_size.extend_from_slice(&r.point_size[n..]);
+    let map = |q: u32| {
+        if (q as usize) < n {
+            pts[q as usize]
+        } else {
+            base + q - n as u32
+        }
+    };
+    res.tets.extend(r.tets.iter().map(|t| t.map(map)));
+    Some(r.tets.len())
 }
 
 /// Takes a front call's tets, new points (global ids from `base`) and the
