@@ -10,7 +10,7 @@
 //! The cells follow from the front and `parts` alone, and the passes'
 //! messages are ordered by part: the DDG depends on `parts`, never on the
 //! threads.
-use crate::{parallel_pass, peel_stuck, seed_parts, serial_pass, PassError, Regions, Sizes};
+use crate::{parallel_pass, peel_stuck, seed_parts, serial_pass, Part, PassError, Regions, Sizes};
 use parafront_comm::Comm;
 use parafront_ddg::{self as ddg, Ddg};
 use parafront_front::RegionFilter;
@@ -370,22 +370,7 @@ pub(crate) fn build_ddg_at<C: Comm>(
         let t0 = Instant::now();
         // The cells split the faces still to advance (an all-gather of
         // their centroids, in part order).
-        let cen: Vec<P3> = comm
-            .all_gather(
-                parts
-                    .iter()
-                    .map(|p| {
-                        p.front
-                            .iter()
-                            .map(|f| {
-                                let [a, b, c] = f.map(|i| p.pts[i as usize]);
-                                parafront_geom::centroid3(a, b, c)
-                            })
-                            .collect::<Vec<P3>>()
-                    })
-                    .collect(),
-            )
-            .concat();
+        let cen = front_centroids(&parts, comm);
         if cen.is_empty() {
             break;
         }
@@ -425,13 +410,54 @@ pub(crate) fn build_ddg_at<C: Comm>(
     st.pass_tets.push(made);
     st.pass_seconds.push(t0.elapsed().as_secs_f64());
 
-    // One mesh: input points first (their ids), then the new points in
-    // global order, those no tet uses left out; tets by part.
     let t0 = Instant::now();
-    let n = next_gid as usize;
+    let (pts, tets, neigh) = merge_parts(parts, points.len(), next_gid as usize)?;
+    st.merge_seconds = t0.elapsed().as_secs_f64();
+    Ok((
+        Ddg {
+            points: pts,
+            tets,
+            neigh,
+            n_input: points.len(),
+            growth: c,
+            seconds: t_all.elapsed().as_secs_f64(),
+        },
+        st,
+    ))
+}
+
+/// The centroids of the faces the parts still have to advance, in part
+/// order (an all-gather): what the next pass's cells split.
+fn front_centroids<C: Comm>(parts: &[Part], comm: &C) -> Vec<P3> {
+    comm.all_gather(
+        parts
+            .iter()
+            .map(|p| {
+                p.front
+                    .iter()
+                    .map(|f| {
+                        let [a, b, c] = f.map(|i| p.pts[i as usize]);
+                        parafront_geom::centroid3(a, b, c)
+                    })
+                    .collect::<Vec<P3>>()
+            })
+            .collect(),
+    )
+    .concat()
+}
+
+/// One mesh of the parts: the `n_input` input points first (their ids),
+/// then the new points (global ids below `n`) in order, those no tet uses
+/// left out; tets by part; and its adjacency.
+#[allow(clippy::type_complexity)]
+fn merge_parts(
+    parts: Vec<Part>,
+    n_input: usize,
+    n: usize,
+) -> Result<(Vec<P3>, Vec<[u32; 4]>, Vec<u32>), PassError> {
     let mut at: Vec<P3> = vec![[0.0; 3]; n];
     let mut used = vec![false; n];
-    used[..points.len()].iter_mut().for_each(|u| *u = true);
+    used[..n_input].iter_mut().for_each(|u| *u = true);
     let mut tets: Vec<[u32; 4]> = Vec::new();
     for part in &parts {
         for (i, &g) in part.gid.iter().enumerate() {
@@ -464,18 +490,7 @@ pub(crate) fn build_ddg_at<C: Comm>(
         .map(|f| f.0)
         .collect();
     drop(typed);
-    st.merge_seconds = t0.elapsed().as_secs_f64();
-    Ok((
-        Ddg {
-            points: pts,
-            tets,
-            neigh,
-            n_input: points.len(),
-            growth: c,
-            seconds: t_all.elapsed().as_secs_f64(),
-        },
-        st,
-    ))
+    Ok((pts, tets, neigh))
 }
 
 #[cfg(test)]
