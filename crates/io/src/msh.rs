@@ -159,7 +159,18 @@ fn v41(
 ) -> std::io::Result<()> {
     let vols = groups(m, &m.tets, region);
     let surfs = groups(m, &m.bnd_tris, patch);
-    // $Entities: no points or curves; a bounding box per entity.
+    v41_entities(w, &surfs, &vols, b)?;
+    v41_nodes(w, m, &surfs, &vols, b)?;
+    v41_elements(w, m, &surfs, &vols, b)
+}
+
+/// `$Entities`: no points or curves; a bounding box per entity.
+fn v41_entities(
+    w: &mut impl Write,
+    surfs: &[Group],
+    vols: &[Group],
+    b: bool,
+) -> std::io::Result<()> {
     writeln!(w, "$Entities")?;
     if b {
         for n in [0, 0, surfs.len(), vols.len()] {
@@ -168,7 +179,7 @@ fn v41(
     } else {
         writeln!(w, "0 0 {} {}", surfs.len(), vols.len())?;
     }
-    for gs in [&surfs, &vols] {
+    for gs in [surfs, vols] {
         for g in gs.iter() {
             if b {
                 int(w, g.phys as i32)?;
@@ -194,8 +205,17 @@ fn v41(
         writeln!(w)?;
     }
     writeln!(w, "$EndEntities")?;
+    Ok(())
+}
 
-    // $Nodes: one block, in the first volume (else surface) entity.
+/// `$Nodes`: one block, in the first volume (else surface) entity.
+fn v41_nodes(
+    w: &mut impl Write,
+    m: &TetMesh,
+    surfs: &[Group],
+    vols: &[Group],
+    b: bool,
+) -> std::io::Result<()> {
     let first = vols.first().or(surfs.first()).map_or(0, |g| g.phys as i32);
     let np = m.points.len();
     let block = if !vols.is_empty() {
@@ -244,8 +264,17 @@ fn v41(
         writeln!(w)?;
     }
     writeln!(w, "$EndNodes")?;
+    Ok(())
+}
 
-    // $Elements: a block per entity.
+/// `$Elements`: a block per entity.
+fn v41_elements(
+    w: &mut impl Write,
+    m: &TetMesh,
+    surfs: &[Group],
+    vols: &[Group],
+    b: bool,
+) -> std::io::Result<()> {
     let (nt, nb) = (m.tets.len(), m.bnd_tris.len());
     let ne = nt + nb;
     writeln!(w, "$Elements")?;
@@ -257,7 +286,7 @@ fn v41(
     } else {
         writeln!(w, "{nblocks} {ne} {} {ne}", 1.min(ne))?;
     }
-    for (dim, gs) in [(2, &surfs), (3, &vols)] {
+    for (dim, gs) in [(2, surfs), (3, vols)] {
         for g in gs.iter() {
             let n = g.members.len();
             let (etype, base) = if dim == 3 { (4, 0) } else { (2, nt) };
