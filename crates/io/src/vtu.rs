@@ -209,6 +209,20 @@ fn piece_arrays<'a>(
     if !opts.vtu_int64 && nconn > i32::MAX as usize {
         return Err(bad(format!("{nconn} connectivity entries need Int64")));
     }
+    let mut out = user_arrays(p, np, nt, nc, &bad)?;
+    out.extend(mesh_arrays(m, opts.vtu_int64));
+    Ok(out)
+}
+
+/// The caller's point and cell arrays, checked against the mesh: a cell
+/// array may cover the tets alone; `region` and `patch` are reserved.
+fn user_arrays<'a>(
+    p: &Piece<'a>,
+    np: usize,
+    nt: usize,
+    nc: usize,
+    bad: &impl Fn(String) -> IoError,
+) -> Result<Vec<Arr<'a>>, IoError> {
     let mut out = Vec::new();
     for (fields, section, count) in [
         (&p.point_fields, Section::PointData, np),
@@ -243,6 +257,15 @@ fn piece_arrays<'a>(
             });
         }
     }
+    Ok(out)
+}
+
+/// The mesh's own arrays: region and patch per cell, the points, and the
+/// cells (Int64 ids when `int64`).
+fn mesh_arrays(m: &TetMesh, int64: bool) -> Vec<Arr<'_>> {
+    let (np, nt, nb) = (m.points.len(), m.tets.len(), m.bnd_tris.len());
+    let (nc, nconn) = (nt + nb, 4 * nt + 3 * nb);
+    let mut out = Vec::new();
     let (tets, tris, region, patch) = (&m.tets, &m.bnd_tris, &m.region, &m.bnd_patch);
     out.push(Arr {
         section: Section::CellData,
@@ -278,7 +301,7 @@ fn piece_arrays<'a>(
             4 * nt + 3 * (i - nt + 1)
         }
     };
-    let (csrc, osrc) = if opts.vtu_int64 {
+    let (csrc, osrc) = if int64 {
         (
             src(nconn, move |i| conn(i) as i64),
             src(nc, move |i| offs(i) as i64),
@@ -307,7 +330,7 @@ fn piece_arrays<'a>(
         ncomp: 1,
         src: src(nc, move |i| if i < nt { 10u8 } else { 5u8 }),
     });
-    Ok(out)
+    out
 }
 
 /// An array as it goes into the appended section.
