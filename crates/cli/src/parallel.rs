@@ -158,6 +158,68 @@ pub fn write_partitioned(path: &Path, sum: &Summary, w: &WriteOptions) -> Result
     Ok(())
 }
 
+/// One row of `parafront bench`'s table: `n` tets made by `p` parts on
+/// `t` threads in `secs` (wall) and `cpu` seconds.
+fn print_bench_row(p: usize, t: usize, n: usize, secs: f64, cpu: f64, sum: &Summary) {
+    let ddg_cpu: f64 = sum
+        .parallel
+        .iter()
+        .map(|x| x.ddg_cpu_seconds + x.partition_cpu_seconds)
+        .sum();
+    let cores = t.max(1);
+    let nprol = (cores / p.max(1)).max(1);
+    let st = sum.parallel.first();
+    let share = |k: usize| {
+        st.map_or(if k == 0 { 100.0 } else { 0.0 }, |_| {
+            let tot: usize = sum
+                .parallel
+                .iter()
+                .map(|x| x.pass_tets.iter().sum::<usize>())
+                .sum();
+            100.0 * sum.parallel.iter().map(|x| x.pass_tets[k]).sum::<usize>() as f64
+                / tot.max(1) as f64
+        })
+    };
+    let crit: f64 = if sum.parallel.is_empty() {
+        secs
+    } else {
+        sum.total_seconds()
+            - sum
+                .parallel
+                .iter()
+                .map(|x| x.pass_seconds[..3].iter().sum::<f64>())
+                .sum::<f64>()
+            + sum
+                .parallel
+                .iter()
+                .map(|x| {
+                    x.part_seconds
+                        .iter()
+                        .map(|v| v.iter().cloned().fold(0.0, f64::max))
+                        .sum::<f64>()
+                })
+                .sum::<f64>()
+    };
+    println!(
+    "{:>5} {:>5} {:>5} {:>9} {:>9.2} {:>11.0} {:>11.0} | {:>7.2} {:>7.2} {:>7.2} {:>7.2} {:>7.2} {:>7.2} | {:>6.2} {:>6.2} {:>6.2} {:>6.2} | {:>6.3} {:>6.3} {:>8.2} | {:>5} {:>6} {:>8.0} {:>4} {:>7.3} | {:>8.2} {:>6.2} {:>6.2}",
+    p, nprol, cores, n, secs, n as f64 / secs, n as f64 / secs / cores as f64,
+    sum.seconds(Stage::Ddg) + 0.0, sum.seconds(Stage::Partition) + 0.0,
+    if p > 1 { sum.seconds(Stage::Pass1) } else { sum.seconds(Stage::Front) } + 0.0,
+    sum.seconds(Stage::Pass2) + 0.0, sum.seconds(Stage::Pass3) + 0.0, sum.seconds(Stage::Pass4) + 0.0,
+    share(0), share(1), share(2), share(3),
+    st.map_or(1.0, |x| x.predicted_imbalance), st.map_or(1.0, |x| x.held_imbalance),
+    crit,
+    st.map_or("-", |x| x.partition.name()),
+    st.map_or(0, |x| x.cut_faces),
+    st.map_or(0.0, |x| x.cut_fine_faces),
+    st.map_or(1, |x| x.max_components),
+    st.map_or(0.0, |x| x.split_seconds),
+    cpu,
+    100.0 * (sum.seconds(Stage::Ddg) + sum.seconds(Stage::Partition)) / secs + 0.0,
+    if cpu > 0.0 { 100.0 * ddg_cpu / cpu + 0.0 } else { 0.0 }
+);
+}
+
 /// `parafront bench`: every (parts, threads) pair on one surface.
 pub fn run_bench(
     path: &Path,
@@ -181,7 +243,6 @@ pub fn run_bench(
         "%p1", "%p2", "%p3", "%p4", "imbP", "imbH", "crit s",
         "split", "cut", "cutF", "pcs", "split s", "cpu s", "%ddgW", "%ddgC"
     );
-    let mut base: Option<f64> = None;
     for &p in parts {
         // P = 1 is the serial front: no partition, one row.
         let methods = if p > 1 { methods } else { &methods[..1] };
@@ -211,65 +272,7 @@ pub fn run_bench(
                 let cpu = parafront_pipeline::process_cpu_seconds()
                     .zip(cpu0)
                     .map_or(0.0, |(a, b)| a - b);
-                let ddg_cpu: f64 = sum
-                    .parallel
-                    .iter()
-                    .map(|x| x.ddg_cpu_seconds + x.partition_cpu_seconds)
-                    .sum();
-                let n = m.tets.len();
-                let cores = t.max(1);
-                let nprol = (cores / p.max(1)).max(1);
-                let st = sum.parallel.first();
-                let share = |k: usize| {
-                    st.map_or(if k == 0 { 100.0 } else { 0.0 }, |_| {
-                        let tot: usize = sum
-                            .parallel
-                            .iter()
-                            .map(|x| x.pass_tets.iter().sum::<usize>())
-                            .sum();
-                        100.0 * sum.parallel.iter().map(|x| x.pass_tets[k]).sum::<usize>() as f64
-                            / tot.max(1) as f64
-                    })
-                };
-                let crit: f64 = if sum.parallel.is_empty() {
-                    secs
-                } else {
-                    sum.total_seconds()
-                        - sum
-                            .parallel
-                            .iter()
-                            .map(|x| x.pass_seconds[..3].iter().sum::<f64>())
-                            .sum::<f64>()
-                        + sum
-                            .parallel
-                            .iter()
-                            .map(|x| {
-                                x.part_seconds
-                                    .iter()
-                                    .map(|v| v.iter().cloned().fold(0.0, f64::max))
-                                    .sum::<f64>()
-                            })
-                            .sum::<f64>()
-                };
-                base.get_or_insert(secs);
-                println!(
-                "{:>5} {:>5} {:>5} {:>9} {:>9.2} {:>11.0} {:>11.0} | {:>7.2} {:>7.2} {:>7.2} {:>7.2} {:>7.2} {:>7.2} | {:>6.2} {:>6.2} {:>6.2} {:>6.2} | {:>6.3} {:>6.3} {:>8.2} | {:>5} {:>6} {:>8.0} {:>4} {:>7.3} | {:>8.2} {:>6.2} {:>6.2}",
-                p, nprol, cores, n, secs, n as f64 / secs, n as f64 / secs / cores as f64,
-                sum.seconds(Stage::Ddg) + 0.0, sum.seconds(Stage::Partition) + 0.0,
-                if p > 1 { sum.seconds(Stage::Pass1) } else { sum.seconds(Stage::Front) } + 0.0,
-                sum.seconds(Stage::Pass2) + 0.0, sum.seconds(Stage::Pass3) + 0.0, sum.seconds(Stage::Pass4) + 0.0,
-                share(0), share(1), share(2), share(3),
-                st.map_or(1.0, |x| x.predicted_imbalance), st.map_or(1.0, |x| x.held_imbalance),
-                crit,
-                st.map_or("-", |x| x.partition.name()),
-                st.map_or(0, |x| x.cut_faces),
-                st.map_or(0.0, |x| x.cut_fine_faces),
-                st.map_or(1, |x| x.max_components),
-                st.map_or(0.0, |x| x.split_seconds),
-                cpu,
-                100.0 * (sum.seconds(Stage::Ddg) + sum.seconds(Stage::Partition)) / secs + 0.0,
-                if cpu > 0.0 { 100.0 * ddg_cpu / cpu + 0.0 } else { 0.0 }
-            );
+                print_bench_row(p, t, m.tets.len(), secs, cpu, &sum);
                 for (r, e) in &sum.serial_fallback {
                     println!(
                         "      ^ region {r}: the serial front meshed it ({e}); the row's seconds include the passes given up"
