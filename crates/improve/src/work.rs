@@ -480,58 +480,26 @@ const NEW_FACE: u32 = 1 << 31;
 /// Drops the dead tet slots and the points marked in `dead_pt`,
 /// renumbering tets, neighbours (when built) and boundary triangles.
 pub(crate) fn compact_arrays(m: &mut TetMesh, dead_pt: &[bool]) {
+    use parafront_mesh::compact::{compact, keep_map, remap_face};
     let nt = m.tets.len();
     let has_neigh = m.neigh.len() == 4 * nt;
-    let mut tmap = vec![u32::MAX; nt];
-    let mut k = 0u32;
-    for t in 0..nt {
-        if m.tets[t] != DEAD {
-            tmap[t] = k;
-            k += 1;
-        }
+    let (tmap, _) = keep_map(m.tets.iter().map(|t| *t != DEAD));
+    let (pmap, _) =
+        keep_map((0..m.points.len()).map(|p| !dead_pt.get(p).copied().unwrap_or(false)));
+    compact(&mut m.tets, &tmap, 1);
+    for t in &mut m.tets {
+        *t = t.map(|p| PointId(pmap[p.idx()]));
     }
-    let mut pmap = vec![u32::MAX; m.points.len()];
-    let mut kp = 0u32;
-    for p in 0..m.points.len() {
-        if !dead_pt.get(p).copied().unwrap_or(false) {
-            pmap[p] = kp;
-            kp += 1;
-        }
-    }
-    let mut w = 0;
-    for t in 0..nt {
-        if tmap[t] == u32::MAX {
-            continue;
-        }
-        m.tets[w] = m.tets[t].map(|p| PointId(pmap[p.idx()]));
-        m.region[w] = m.region[t];
-        if has_neigh {
-            for f in 0..4 {
-                let n = m.neigh[4 * t + f];
-                m.neigh[4 * w + f] = if n.is_none() {
-                    NO_FACE
-                } else {
-                    FaceRef(tmap[n.tet().idx()] * 4 + n.local() as u32)
-                };
-            }
-        }
-        w += 1;
-    }
-    m.tets.truncate(w);
-    m.region.truncate(w);
+    compact(&mut m.region, &tmap, 1);
     if has_neigh {
-        m.neigh.truncate(4 * w);
+        compact(&mut m.neigh, &tmap, 4);
+        for n in &mut m.neigh {
+            *n = FaceRef(remap_face(n.0, &tmap, NO_FACE.0));
+        }
     } else {
         m.neigh.clear();
     }
-    let mut wp = 0;
-    for p in 0..m.points.len() {
-        if pmap[p] != u32::MAX {
-            m.points[wp] = m.points[p];
-            wp += 1;
-        }
-    }
-    m.points.truncate(wp);
+    compact(&mut m.points, &pmap, 1);
     for t in &mut m.bnd_tris {
         *t = t.map(|p| PointId(pmap[p.idx()]));
     }

@@ -17,6 +17,7 @@
 
 mod adjacency;
 mod check;
+pub mod compact;
 mod faces;
 pub mod generate;
 pub mod ids;

@@ -698,21 +698,14 @@ impl<'a> Front<'a> {
             .map(|&f| self.fv[f as usize].v)
             .collect();
         drop(self.fv);
+        use parafront_mesh::compact::{compact, keep_map, remap_face};
         let (mut tets, mut neigh, talive) = (self.tets, self.neigh, self.talive);
-        let nt = tets.len();
-        let mut tmap = vec![NONE; nt];
-        let mut k = 0u32;
-        for t in 0..nt {
-            if talive[t] {
-                tmap[t] = k;
-                k += 1;
-            }
-        }
+        let (tmap, _) = keep_map(talive.iter().copied());
         let mut used = vec![false; self.pts.len()];
         used[..self.n_input].iter_mut().for_each(|u| *u = true);
-        for t in 0..nt {
-            if talive[t] {
-                for &p in &tets[t] {
+        for (tv, &alive) in tets.iter().zip(&talive) {
+            if alive {
+                for &p in tv {
                     used[p as usize] = true;
                 }
             }
@@ -722,38 +715,19 @@ impl<'a> Front<'a> {
                 used[p as usize] = true;
             }
         }
-        let mut pmap = vec![NONE; self.pts.len()];
+        let (pmap, _) = keep_map(used);
         let (mut points, mut point_size) = (self.pts, self.hp);
-        let mut np = 0;
-        for i in 0..used.len() {
-            if used[i] {
-                pmap[i] = np as u32;
-                points[np] = points[i];
-                point_size[np] = point_size[i];
-                np += 1;
-            }
+        compact(&mut points, &pmap, 1);
+        compact(&mut point_size, &pmap, 1);
+        // In place: slot k <= t is free when tet t moves there.
+        compact(&mut tets, &tmap, 1);
+        for t in &mut tets {
+            *t = t.map(|p| pmap[p as usize]);
         }
-        points.truncate(np);
-        point_size.truncate(np);
-        // Compact in place: slot k <= t is free when tet t moves there.
-        for t in 0..nt {
-            let j = tmap[t];
-            if j == NONE {
-                continue;
-            }
-            let j = j as usize;
-            tets[j] = tets[t].map(|p| pmap[p as usize]);
-            for i in 0..4 {
-                let nb = neigh[4 * t + i];
-                neigh[4 * j + i] = if nb == NONE {
-                    NONE
-                } else {
-                    4 * tmap[(nb >> 2) as usize] + (nb & 3)
-                };
-            }
+        compact(&mut neigh, &tmap, 4);
+        for n in &mut neigh {
+            *n = remap_face(*n, &tmap, NONE);
         }
-        tets.truncate(k as usize);
-        neigh.truncate(4 * k as usize);
         let mut stats = self.stats;
         stats.tets = tets.len();
         stats.new_points = points.len() - self.n_input;
