@@ -448,13 +448,13 @@ fn write_partial(path: &Path, e: &parafront_front::FrontError, w: &WriteOptions)
         tets: p
             .tets
             .iter()
-            .map(|t| t.map(parafront_mesh::PointId))
+            .map(|t| t.map(parafront_mesh::PointId::from_raw))
             .collect(),
         region: vec![0; p.tets.len()],
         bnd_tris: p
             .front
             .iter()
-            .map(|f| f.map(parafront_mesh::PointId))
+            .map(|f| f.map(parafront_mesh::PointId::from_raw))
             .collect(),
         bnd_patch: vec![0; p.front.len()],
         ..Default::default()
@@ -655,7 +655,7 @@ fn run_demo_check(s: &Surface, out: &Path, w: &WriteArgs) -> Result<(), Fail> {
         bnd_tris: s
             .tris
             .iter()
-            .map(|t| t.map(parafront_mesh::PointId))
+            .map(|t| t.map(parafront_mesh::PointId::from_raw))
             .collect(),
         bnd_patch: s.patch.clone(),
         ..Default::default()

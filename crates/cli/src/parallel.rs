@@ -122,7 +122,7 @@ pub fn write_partitioned(path: &Path, sum: &Summary, w: &WriteOptions) -> Result
         arrays.push(Arrays {
             mesh: TetMesh {
                 points: pc.points.clone(),
-                tets: pc.tets.iter().map(|t| t.map(PointId)).collect(),
+                tets: pc.tets.iter().map(|t| t.map(PointId::from_raw)).collect(),
                 region: vec![region; pc.tets.len()],
                 ..Default::default()
             },

@@ -152,7 +152,7 @@ fn a_box_mesh_passes_meshcheck() {
     m.check_against_surface(
         &m.bnd_tris
             .iter()
-            .map(|t| t.map(|p| p.0))
+            .map(|t| t.map(|p| p.raw()))
             .collect::<Vec<_>>(),
     )
     .unwrap();

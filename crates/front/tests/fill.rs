@@ -21,14 +21,14 @@ fn fill(s: &Surface, h: f64) -> (TetMesh, FrontStats) {
     assert!(r.front.is_empty());
     let mut m = TetMesh {
         points: r.points,
-        tets: r.tets.iter().map(|t| t.map(PointId)).collect(),
+        tets: r.tets.iter().map(|t| t.map(PointId::from_raw)).collect(),
         region: vec![0; r.tets.len()],
         ..Default::default()
     };
     m.neigh = r
         .neigh
         .iter()
-        .map(|&f| parafront_mesh::FaceRef(f))
+        .map(|&f| parafront_mesh::FaceRef::from_raw(f))
         .collect();
     let stats = m
         .check_against_surface(&s.tris)
@@ -130,7 +130,7 @@ fn a_pass_hands_its_front_to_the_next() {
             .tets
             .iter()
             .chain(&r2.tets)
-            .map(|t| t.map(PointId))
+            .map(|t| t.map(PointId::from_raw))
             .collect(),
         region: vec![0; r1.tets.len() + r2.tets.len()],
         ..Default::default()
@@ -216,7 +216,7 @@ fn a_smooth_sphere_has_few_slivers_before_improvement() {
         .tets
         .iter()
         .filter(|t| {
-            let p = t.map(|i| m.points[i.0 as usize]);
+            let p = t.map(|i| m.points[i.raw() as usize]);
             parafront_mesh::quality::dihedral_angles(p)
                 .iter()
                 .any(|&a| a < 10.0)

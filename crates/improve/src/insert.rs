@@ -146,7 +146,7 @@ impl Work<'_> {
             let v = self.m.tets[t as usize];
             for f in 0..4 {
                 let n = self.m.neigh[4 * t as usize + f];
-                if !n.is_none() && s.cav.contains(&n.tet().0) {
+                if !n.is_none() && s.cav.contains(&n.tet().raw()) {
                     continue;
                 }
                 s.star.push((v, f));
@@ -230,7 +230,7 @@ impl Work<'_> {
         match k {
             0..=3 => match self.free_neighbour(t, k) {
                 Some(n) => {
-                    s.cav.push(n.tet().0);
+                    s.cav.push(n.tet().raw());
                     true
                 }
                 None => false,
@@ -238,8 +238,8 @@ impl Work<'_> {
             4 => {
                 for f in 0..4 {
                     if let Some(n) = self.free_neighbour(t, f) {
-                        if !s.cav.contains(&n.tet().0) {
-                            s.cav.push(n.tet().0);
+                        if !s.cav.contains(&n.tet().raw()) {
+                            s.cav.push(n.tet().raw());
                         }
                     }
                 }

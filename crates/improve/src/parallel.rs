@@ -105,11 +105,11 @@ struct Piece {
 fn cut(mesh: &TetMesh, tets: &[u32], frozen: &[bool], level: u8) -> Result<Piece, TopoError> {
     let mut global: Vec<u32> = tets
         .iter()
-        .flat_map(|&t| mesh.tets[t as usize].map(|p| p.0))
+        .flat_map(|&t| mesh.tets[t as usize].map(|p| p.raw()))
         .collect();
     global.sort_unstable();
     global.dedup();
-    let local = |p: PointId| PointId(global.binary_search(&p.0).unwrap_or(0) as u32);
+    let local = |p: PointId| PointId::from_raw(global.binary_search(&p.raw()).unwrap_or(0) as u32);
     let mut sub = TetMesh {
         points: global.iter().map(|&p| mesh.points[p as usize]).collect(),
         tets: tets
@@ -192,7 +192,7 @@ fn pass(
             pc.mesh
                 .tets
                 .iter()
-                .map(|t| t.map(|p| PointId(pc.global[p.idx()]))),
+                .map(|t| t.map(|p| PointId::from_raw(pc.global[p.idx()]))),
         );
         mesh.region.extend_from_slice(&pc.mesh.region);
         new_part.extend(std::iter::repeat_n(k as u32, pc.mesh.tets.len()));

@@ -8,7 +8,7 @@ use parafront_geom::P3;
 use parafront_mesh::{FaceRef, PointId, TetMesh, NO_FACE, TET_FACES};
 
 /// Vertex ids of a dead tet slot.
-pub(crate) const DEAD: [PointId; 4] = [PointId(u32::MAX); 4];
+pub(crate) const DEAD: [PointId; 4] = [PointId::from_raw(u32::MAX); 4];
 /// Most tets around an edge that edge removal considers.
 pub(crate) const MAX_RING: usize = 10;
 
@@ -175,7 +175,7 @@ impl<'m> Work<'m> {
         let v = self.m.tets[t as usize];
         let d = v[f];
         let [a, b, c] = TET_FACES[f].map(|l| v[l]);
-        let nt = n.tet().0;
+        let nt = n.tet().raw();
         let e = self.m.tets[nt as usize][n.local()];
         Some((nt, [[d, e, a, b], [d, e, b, c], [d, e, c, a]]))
     }
@@ -256,7 +256,7 @@ impl<'m> Work<'m> {
             let cv = self.m.tets[cur as usize];
             let lf = cv.iter().position(|&x| x == r0)?;
             let n = self.free_neighbour(cur, lf)?;
-            let nt = n.tet().0;
+            let nt = n.tet().raw();
             if nt == t {
                 return Some(());
             }
@@ -311,8 +311,8 @@ impl<'m> Work<'m> {
             }
             self.p2t[p.idx()] = outer
                 .iter()
-                .find(|o| !o.1.is_none() && o.0.contains(&p.0))
-                .map_or(u32::MAX, |o| o.1.tet().0);
+                .find(|o| !o.1.is_none() && o.0.contains(&p.raw()))
+                .map_or(u32::MAX, |o| o.1.tet().raw());
         }
         self.outer = outer;
         self.link = link;
@@ -330,10 +330,10 @@ impl<'m> Work<'m> {
             let v = self.m.tets[t as usize];
             for (f, fl) in TET_FACES.iter().enumerate() {
                 let n = self.m.neigh[4 * t as usize + f];
-                if !n.is_none() && old.contains(&n.tet().0) {
+                if !n.is_none() && old.contains(&n.tet().raw()) {
                     continue;
                 }
-                outer.push((key3(fl.map(|l| v[l].0)), n));
+                outer.push((key3(fl.map(|l| v[l].raw())), n));
             }
         }
     }
@@ -364,7 +364,7 @@ impl<'m> Work<'m> {
                 if link[4 * i + g] != UNSET {
                     continue;
                 }
-                let k = key3(fl.map(|l| new[i][l].0));
+                let k = key3(fl.map(|l| new[i][l].raw()));
                 if let Some(o) = outer.iter().position(|x| x.0 == k) {
                     if used[o] {
                         ok = false;
@@ -377,7 +377,7 @@ impl<'m> Work<'m> {
                 let mut found = false;
                 for j in i + 1..new.len() {
                     for (h, hl) in TET_FACES.iter().enumerate() {
-                        if key3(hl.map(|l| new[j][l].0)) == k {
+                        if key3(hl.map(|l| new[j][l].raw())) == k {
                             if found || link[4 * j + h] != UNSET {
                                 ok = false;
                             }
@@ -436,17 +436,17 @@ impl<'m> Work<'m> {
             self.tested[s] = false;
             self.dok[s] = false;
             for g in 0..4 {
-                let me = FaceRef::of(parafront_mesh::TetId(s as u32), g);
+                let me = FaceRef::of(parafront_mesh::TetId::from_raw(s as u32), g);
                 let l = link[4 * i + g];
                 if l & NEW_FACE != 0 {
                     let jh = (l & !NEW_FACE) as usize;
                     self.m.neigh[4 * s + g] =
-                        FaceRef::of(parafront_mesh::TetId(slots[jh / 4]), jh % 4);
+                        FaceRef::of(parafront_mesh::TetId::from_raw(slots[jh / 4]), jh % 4);
                 } else {
                     let n = outer[l as usize].1;
                     self.m.neigh[4 * s + g] = n;
                     if !n.is_none() {
-                        self.m.neigh[n.0 as usize] = me;
+                        self.m.neigh[n.raw() as usize] = me;
                         // Its surroundings changed: worth testing again.
                         self.tested[n.tet().idx()] = false;
                     }
@@ -488,19 +488,19 @@ pub(crate) fn compact_arrays(m: &mut TetMesh, dead_pt: &[bool]) {
         keep_map((0..m.points.len()).map(|p| !dead_pt.get(p).copied().unwrap_or(false)));
     compact(&mut m.tets, &tmap, 1);
     for t in &mut m.tets {
-        *t = t.map(|p| PointId(pmap[p.idx()]));
+        *t = t.map(|p| PointId::from_raw(pmap[p.idx()]));
     }
     compact(&mut m.region, &tmap, 1);
     if has_neigh {
         compact(&mut m.neigh, &tmap, 4);
         for n in &mut m.neigh {
-            *n = FaceRef(remap_face(n.0, &tmap, NO_FACE.0));
+            *n = FaceRef::from_raw(remap_face(n.raw(), &tmap, NO_FACE.raw()));
         }
     } else {
         m.neigh.clear();
     }
     compact(&mut m.points, &pmap, 1);
     for t in &mut m.bnd_tris {
-        *t = t.map(|p| PointId(pmap[p.idx()]));
+        *t = t.map(|p| PointId::from_raw(pmap[p.idx()]));
     }
 }

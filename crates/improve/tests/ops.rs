@@ -14,7 +14,7 @@ fn mesh(points: Vec<P3>, tets: &[[u32; 4]]) -> TetMesh {
         ..Default::default()
     };
     for t in tets {
-        let mut v = t.map(PointId);
+        let mut v = t.map(PointId::from_raw);
         let p = v.map(|x| m.points[x.idx()]);
         if orient3d(p[0], p[1], p[2], p[3]) < 0.0 {
             v.swap(2, 3);
@@ -28,7 +28,7 @@ fn mesh(points: Vec<P3>, tets: &[[u32; 4]]) -> TetMesh {
 }
 
 fn tris(m: &TetMesh) -> Vec<[u32; 3]> {
-    m.bnd_tris.iter().map(|t| t.map(|p| p.0)).collect()
+    m.bnd_tris.iter().map(|t| t.map(|p| p.raw())).collect()
 }
 
 fn worst(m: &TetMesh) -> f64 {
@@ -85,7 +85,10 @@ fn two_three_swap_of_two_flat_tets() {
     let (tr, vol, q0) = (tris(&m), m.volume(), worst(&m));
     let mut imp = Improver::new(&mut m, &[]).unwrap();
     // Tet 0's face opposite its apex (point 4).
-    let f = imp.mesh().tets[0].iter().position(|p| p.0 == 4).unwrap();
+    let f = imp.mesh().tets[0]
+        .iter()
+        .position(|p| p.raw() == 4)
+        .unwrap();
     assert_eq!(imp.swap_face(0, f), Outcome::Done);
     imp.finish();
     assert_eq!(m.tets.len(), 3);
@@ -95,7 +98,7 @@ fn two_three_swap_of_two_flat_tets() {
     assert!(m
         .tets
         .iter()
-        .all(|t| t.contains(&PointId(3)) && t.contains(&PointId(4))));
+        .all(|t| t.contains(&PointId::from_raw(3)) && t.contains(&PointId::from_raw(4))));
 }
 
 #[test]
@@ -104,7 +107,10 @@ fn three_two_swap_of_a_long_edge() {
     let mut m = ring_mesh(3, 1.5);
     let (tr, vol, q0) = (tris(&m), m.volume(), worst(&m));
     let mut imp = Improver::new(&mut m, &[]).unwrap();
-    assert_eq!(imp.remove_edge(0, PointId(3), PointId(4)), Outcome::Done);
+    assert_eq!(
+        imp.remove_edge(0, PointId::from_raw(3), PointId::from_raw(4)),
+        Outcome::Done
+    );
     imp.finish();
     assert_eq!(m.tets.len(), 2);
     assert_same_domain(&m, &tr, vol);
@@ -113,7 +119,7 @@ fn three_two_swap_of_a_long_edge() {
     let mut imp = Improver::new(&mut m, &[]).unwrap();
     let f = imp.mesh().tets[0]
         .iter()
-        .position(|p| p.0 == 3 || p.0 == 4)
+        .position(|p| p.raw() == 3 || p.raw() == 4)
         .unwrap();
     assert_eq!(imp.swap_face(0, f), Outcome::NotBetter);
 }
@@ -144,7 +150,7 @@ fn edge_removal_of_rings_of_five_and_six() {
         let best = brute_best(&m.points[..n], n, m.points[n], m.points[n + 1]);
         assert!(best > q0, "n={n}: the ring test case should be improvable");
         let mut imp = Improver::new(&mut m, &[]).unwrap();
-        let (d, e) = (PointId(n as u32), PointId(n as u32 + 1));
+        let (d, e) = (PointId::from_raw(n as u32), PointId::from_raw(n as u32 + 1));
         assert_eq!(imp.remove_edge(0, d, e), Outcome::Done, "n={n}");
         imp.finish();
         assert_eq!(m.tets.len(), 2 * n - 4, "n={n}");
@@ -166,12 +172,12 @@ fn edge_removal_refused_when_not_better() {
     let before = m.tets.clone();
     let mut imp = Improver::new(&mut m, &[]).unwrap();
     assert_eq!(
-        imp.remove_edge(0, PointId(4), PointId(5)),
+        imp.remove_edge(0, PointId::from_raw(4), PointId::from_raw(5)),
         Outcome::NotBetter
     );
     // A boundary edge (on the ring) is constrained.
     assert_eq!(
-        imp.remove_edge(0, PointId(0), PointId(1)),
+        imp.remove_edge(0, PointId::from_raw(0), PointId::from_raw(1)),
         Outcome::Constrained
     );
     imp.finish();
@@ -210,12 +216,18 @@ fn collapse_refused_by_the_link_condition() {
     let mut m = dented_ball();
     let before = m.clone();
     let mut imp = Improver::new(&mut m, &[]).unwrap();
-    assert!(imp.is_free(PointId(0)));
-    assert!(!imp.is_free(PointId(1)));
+    assert!(imp.is_free(PointId::from_raw(0)));
+    assert!(!imp.is_free(PointId::from_raw(1)));
     // 0 and 1 share the neighbour 2, but 0-1-2 is no triangle.
-    assert_eq!(imp.collapse(PointId(0), PointId(1)), Outcome::LinkCondition);
+    assert_eq!(
+        imp.collapse(PointId::from_raw(0), PointId::from_raw(1)),
+        Outcome::LinkCondition
+    );
     // 1 is on the boundary: it may not disappear.
-    assert_eq!(imp.collapse(PointId(1), PointId(0)), Outcome::Frozen);
+    assert_eq!(
+        imp.collapse(PointId::from_raw(1), PointId::from_raw(0)),
+        Outcome::Frozen
+    );
     imp.finish();
     assert_eq!(m.tets, before.tets);
     assert_eq!(m.points, before.points);
@@ -230,7 +242,10 @@ fn collapse_of_a_point_next_to_another() {
     m.check().unwrap();
     let (tr, vol, q0) = (tris(&m), m.volume(), worst(&m));
     let mut imp = Improver::new(&mut m, &[]).unwrap();
-    assert_eq!(imp.collapse(PointId(0), PointId(3)), Outcome::Done);
+    assert_eq!(
+        imp.collapse(PointId::from_raw(0), PointId::from_raw(3)),
+        Outcome::Done
+    );
     imp.finish();
     // Point 0 is gone: the others move down one id.
     assert_eq!(m.points.len(), 6);
@@ -246,12 +261,15 @@ fn move_refused_when_it_would_invert() {
     let mut imp = Improver::new(&mut m, &[]).unwrap();
     // Past the dent point: the tets on the dent would turn inside out.
     assert_eq!(
-        imp.move_point(PointId(0), [0.5, 0.0, 0.0]),
+        imp.move_point(PointId::from_raw(0), [0.5, 0.0, 0.0]),
         Outcome::Inverted
     );
     // Boundary points never move.
-    assert_eq!(imp.move_point(PointId(4), [0.0, 0.0, 0.9]), Outcome::Frozen);
-    assert_eq!(imp.smooth_point(PointId(4)), Outcome::Frozen);
+    assert_eq!(
+        imp.move_point(PointId::from_raw(4), [0.0, 0.0, 0.9]),
+        Outcome::Frozen
+    );
+    assert_eq!(imp.smooth_point(PointId::from_raw(4)), Outcome::Frozen);
     imp.finish();
     assert_eq!(m.points, before.points);
 }
@@ -264,7 +282,7 @@ fn smoothing_raises_the_worst_tet() {
     m.check().unwrap();
     let (tr, vol, q0) = (tris(&m), m.volume(), worst(&m));
     let mut imp = Improver::new(&mut m, &[]).unwrap();
-    assert_eq!(imp.smooth_point(PointId(0)), Outcome::Done);
+    assert_eq!(imp.smooth_point(PointId::from_raw(0)), Outcome::Done);
     imp.finish();
     assert_same_domain(&m, &tr, vol);
     assert!(worst(&m) > q0);
@@ -308,20 +326,23 @@ fn insertion_of_a_point_at_a_wall_foot() {
     assert_eq!(under_10(&m), 3);
     let mut imp = Improver::new(&mut m, &[]).unwrap();
     // The three share edge 0-3; neither its removal nor a face swap helps.
-    assert_ne!(imp.remove_edge(0, PointId(0), PointId(3)), Outcome::Done);
+    assert_ne!(
+        imp.remove_edge(0, PointId::from_raw(0), PointId::from_raw(3)),
+        Outcome::Done
+    );
     for t in 0..3 {
         for f in 0..4 {
             assert_ne!(imp.swap_face(t, f), Outcome::Done);
         }
     }
     assert_eq!(imp.insert_point(0, false), Outcome::Done);
-    assert!(imp.is_free(PointId(6)));
+    assert!(imp.is_free(PointId::from_raw(6)));
     imp.finish();
     m.check().unwrap();
     // The same boundary (every old point is on it), one more point.
     assert_same_domain(&m, &tr, vol);
     assert_eq!(m.points.len(), 7);
-    assert!(m.tets.iter().all(|t| t.contains(&PointId(6))));
+    assert!(m.tets.iter().all(|t| t.contains(&PointId::from_raw(6))));
     assert_eq!(under_10(&m), 0);
     assert!(min_dihedral(&m) > d0);
 }

@@ -55,7 +55,7 @@ proptest! {
     ) {
         let m0 = perturbed(&d);
         let tris = |m: &TetMesh| -> Vec<[u32; 3]> {
-            m.bnd_tris.iter().map(|t| t.map(|p| p.0)).collect()
+            m.bnd_tris.iter().map(|t| t.map(|p| p.raw())).collect()
         };
         m0.check_against_surface(&tris(&m0)).unwrap();
         let vol0 = 1.0;

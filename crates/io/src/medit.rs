@@ -23,7 +23,7 @@ pub fn write_medit(path: &Path, m: &TetMesh) -> Result<(), IoError> {
             writeln!(w, "\nTriangles\n{}", m.bnd_tris.len())?;
             write_par(w, m.bnd_tris.len(), |i, buf| {
                 for p in m.bnd_tris[i] {
-                    put_int(buf, p.0 as u64 + 1);
+                    put_int(buf, p.raw() as u64 + 1);
                     buf.push(b' ');
                 }
                 put_int(buf, m.bnd_patch[i]);
@@ -34,7 +34,7 @@ pub fn write_medit(path: &Path, m: &TetMesh) -> Result<(), IoError> {
             writeln!(w, "\nTetrahedra\n{}", m.tets.len())?;
             write_par(w, m.tets.len(), |i, buf| {
                 for p in m.tets[i] {
-                    put_int(buf, p.0 as u64 + 1);
+                    put_int(buf, p.raw() as u64 + 1);
                     buf.push(b' ');
                 }
                 put_int(buf, m.region[i]);

@@ -325,7 +325,7 @@ fn v41_elements(
 /// Point ids of element `e` of dimension `dim` (3: tet, 2: triangle).
 fn cell(m: &TetMesh, dim: i32, e: usize) -> impl Iterator<Item = u32> + '_ {
     let s: &[PointId] = if dim == 3 { &m.tets[e] } else { &m.bnd_tris[e] };
-    s.iter().map(|p| p.0)
+    s.iter().map(|p| p.raw())
 }
 
 fn coords(buf: &mut Vec<u8>, p: [f64; 3]) {

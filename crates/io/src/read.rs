@@ -29,10 +29,10 @@ pub fn read_mesh(path: &Path) -> Result<TetMesh, IoError> {
 fn from_volume(v: VolumeData) -> TetMesh {
     TetMesh {
         points: v.points,
-        tets: v.tets.iter().map(|t| t.map(PointId)).collect(),
+        tets: v.tets.iter().map(|t| t.map(PointId::from_raw)).collect(),
         neigh: Vec::new(),
         region: v.tet_tags,
-        bnd_tris: v.tris.iter().map(|t| t.map(PointId)).collect(),
+        bnd_tris: v.tris.iter().map(|t| t.map(PointId::from_raw)).collect(),
         bnd_patch: v.tri_tags,
     }
 }

@@ -75,7 +75,7 @@ pub fn write_surface(path: &Path, s: &Surface, opts: &WriteOptions) -> Result<()
         SurfaceFormat::Mesh(_) => {
             let m = TetMesh {
                 points: s.points.clone(),
-                bnd_tris: s.tris.iter().map(|t| t.map(PointId)).collect(),
+                bnd_tris: s.tris.iter().map(|t| t.map(PointId::from_raw)).collect(),
                 bnd_patch: s.patch.clone(),
                 ..Default::default()
             };

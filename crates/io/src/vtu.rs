@@ -288,10 +288,10 @@ fn mesh_arrays(m: &TetMesh, int64: bool) -> Vec<Arr<'_>> {
     });
     let conn = move |i: usize| {
         if i < 4 * nt {
-            tets[i / 4][i % 4].0
+            tets[i / 4][i % 4].raw()
         } else {
             let j = i - 4 * nt;
-            tris[j / 3][j % 3].0
+            tris[j / 3][j % 3].raw()
         }
     };
     let offs = move |i: usize| {

@@ -617,7 +617,7 @@ fn read_cells(
             if v < 0 || v as u64 >= np as u64 {
                 return Err(cx.err(format!("piece {pi}: cell {c} refers to point {v} of {np}")));
             }
-            Ok(PointId((base + v as usize) as u32))
+            Ok(PointId::from_raw((base + v as usize) as u32))
         };
         let ty = types[c];
         let want = match ty {

@@ -52,7 +52,7 @@ fn expect(m: &TetMesh) -> Vec<String> {
         "tetra",
         m.tets
             .iter()
-            .map(|t| t.iter().map(|p| p.0).collect())
+            .map(|t| t.iter().map(|p| p.raw()).collect())
             .collect(),
         &m.region,
     );
@@ -60,7 +60,7 @@ fn expect(m: &TetMesh) -> Vec<String> {
         "triangle",
         m.bnd_tris
             .iter()
-            .map(|t| t.iter().map(|p| p.0).collect())
+            .map(|t| t.iter().map(|p| p.raw()).collect())
             .collect(),
         &m.bnd_patch,
     );
@@ -321,7 +321,7 @@ fn surface_of(m: &TetMesh) -> TetMesh {
     let mut seen: HashMap<[u32; 3], (usize, usize)> = HashMap::new();
     for (t, tet) in m.tets.iter().enumerate() {
         for (f, lf) in TET_FACES.iter().enumerate() {
-            let mut k = lf.map(|i| tet[i].0);
+            let mut k = lf.map(|i| tet[i].raw());
             k.sort_unstable();
             if let Some(&(t0, f0)) = seen.get(&k) {
                 if m.region[t0] != m.region[t] {

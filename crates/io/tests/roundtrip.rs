@@ -133,7 +133,7 @@ fn failed_writes_leave_nothing() {
         assert!(e.to_string().contains("region ids"), "{e}");
     }
     let mut m = mesh();
-    m.tets[5][2] = PointId(m.points.len() as u32);
+    m.tets[5][2] = PointId::from_raw(m.points.len() as u32);
     let e = write_mesh(&d.join("bad.vtu"), &m, &WriteOptions::default()).unwrap_err();
     assert!(e.to_string().contains("tet 5"), "{e}");
     assert!(listing(&d).is_empty(), "{:?}", listing(&d));
@@ -300,9 +300,9 @@ fn reads_base64_appended_big_endian_vtu() {
             [0.0, 0.0, 1.5]
         ]
     );
-    assert_eq!(m.tets, vec![[0, 1, 2, 3].map(PointId)]);
+    assert_eq!(m.tets, vec![[0, 1, 2, 3].map(PointId::from_raw)]);
     assert_eq!(m.region, vec![4]);
-    assert_eq!(m.bnd_tris, vec![[0, 2, 1].map(PointId)]);
+    assert_eq!(m.bnd_tris, vec![[0, 2, 1].map(PointId::from_raw)]);
     assert_eq!(m.bnd_patch, vec![9]);
 }
 
@@ -340,7 +340,7 @@ fn reads_ascii_vtu_and_rejects_other_cells() {
     assert_eq!((m.tets.len(), m.region.clone()), (1, vec![2]));
     assert_eq!(
         (m.bnd_tris.clone(), m.bnd_patch.clone()),
-        (vec![[0, 2, 1].map(PointId)], vec![3])
+        (vec![[0, 2, 1].map(PointId::from_raw)], vec![3])
     );
 
     std::fs::write(&p, ASCII_VTU.replace("1 10 5", "1 12 5")).unwrap();
@@ -378,9 +378,9 @@ mod prop {
             let d = scratch("prop");
             let m = TetMesh {
                 points: xs.chunks(3).map(|c| [c[0], c[1], c[2]]).collect(),
-                tets: vec![[0, 1, 2, 3].map(PointId)],
+                tets: vec![[0, 1, 2, 3].map(PointId::from_raw)],
                 region: vec![r],
-                bnd_tris: vec![[0, 2, 1].map(PointId)],
+                bnd_tris: vec![[0, 2, 1].map(PointId::from_raw)],
                 bnd_patch: vec![t],
                 ..Default::default()
             };

@@ -29,7 +29,7 @@ pub enum TopoError {
     /// A face in three or more tets.
     #[error(
         "face ({}, {}, {}) belongs to {} tets {:?}; a face may belong to at most two{}",
-        face[0], face[1], face[2], tets.len(), tets.iter().map(|t| t.0).collect::<Vec<_>>(),
+        face[0], face[1], face[2], tets.len(), tets.iter().map(|t| t.raw()).collect::<Vec<_>>(),
         more_msg(*more)
     )]
     FaceInManyTets {
@@ -84,7 +84,7 @@ impl TetMesh {
             return (0..self.neigh.len())
                 .into_par_iter()
                 .filter(|&i| self.neigh[i].is_none())
-                .map(|i| FaceRef(i as u32))
+                .map(|i| FaceRef::from_raw(i as u32))
                 .collect();
         }
         let keys = face_keys(&self.tets);
@@ -94,7 +94,7 @@ impl TetMesh {
                 let mut v = Vec::new();
                 for_each_group(chunk, |g| {
                     if g.len() == 1 {
-                        v.push(FaceRef(low(g[0])));
+                        v.push(FaceRef::from_raw(low(g[0])));
                     }
                 });
                 v
@@ -145,7 +145,7 @@ pub fn face_neighbours(tets: &[[PointId; 4]]) -> Result<Vec<FaceRef>, TopoError>
     let keys = face_keys(tets);
     let neigh: Vec<AtomicU32> = (0..4 * n)
         .into_par_iter()
-        .map(|_| AtomicU32::new(NO_FACE.0))
+        .map(|_| AtomicU32::new(NO_FACE.raw()))
         .collect();
     let bad = AtomicUsize::new(0);
     // First bad group of each chunk; chunks are in key order, so the
@@ -161,8 +161,8 @@ pub fn face_neighbours(tets: &[[PointId; 4]]) -> Result<Vec<FaceRef>, TopoError>
                     if face_parity(tets, a) == face_parity(tets, b) {
                         bad.fetch_add(1, Relaxed);
                         first.get_or_insert_with(|| TopoError::FaceSameSide {
-                            face: unpack_triple(g[0]).map(PointId),
-                            tets: [FaceRef(a).tet(), FaceRef(b).tet()],
+                            face: unpack_triple(g[0]).map(PointId::from_raw),
+                            tets: [FaceRef::from_raw(a).tet(), FaceRef::from_raw(b).tet()],
                             more: 0,
                         });
                     } else {
@@ -173,8 +173,8 @@ pub fn face_neighbours(tets: &[[PointId; 4]]) -> Result<Vec<FaceRef>, TopoError>
                 _ => {
                     bad.fetch_add(1, Relaxed);
                     first.get_or_insert_with(|| TopoError::FaceInManyTets {
-                        face: unpack_triple(g[0]).map(PointId),
-                        tets: g.iter().map(|&k| FaceRef(low(k)).tet()).collect(),
+                        face: unpack_triple(g[0]).map(PointId::from_raw),
+                        tets: g.iter().map(|&k| FaceRef::from_raw(low(k)).tet()).collect(),
                         more: 0,
                     });
                 }
@@ -195,5 +195,8 @@ pub fn face_neighbours(tets: &[[PointId; 4]]) -> Result<Vec<FaceRef>, TopoError>
         }
         return Err(e);
     }
-    Ok(neigh.into_iter().map(|a| FaceRef(a.into_inner())).collect())
+    Ok(neigh
+        .into_iter()
+        .map(|a| FaceRef::from_raw(a.into_inner()))
+        .collect())
 }

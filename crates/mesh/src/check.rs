@@ -349,12 +349,12 @@ impl TetMesh {
             .map(|chunk| {
                 let mut acc = FaceAcc::default();
                 for_each_group(chunk, |g| {
-                    let face = unpack_triple(g[0]).map(PointId);
+                    let face = unpack_triple(g[0]).map(PointId::from_raw);
                     let expect = |acc: &mut FaceAcc, f: u32, e: FaceRef| {
                         if neigh_ok && self.neigh[f as usize] != e {
                             acc.found.push(MeshProblem::NeighWrong {
-                                face: FaceRef(f),
-                                verts: self.face_points(FaceRef(f)),
+                                face: FaceRef::from_raw(f),
+                                verts: self.face_points(FaceRef::from_raw(f)),
                                 found: self.neigh[f as usize],
                                 expected: e,
                             });
@@ -371,13 +371,16 @@ impl TetMesh {
                             if face_parity(tets, a) == face_parity(tets, b) {
                                 acc.found.push(MeshProblem::FaceSameSide {
                                     face,
-                                    tets: [FaceRef(a).tet(), FaceRef(b).tet()],
+                                    tets: [FaceRef::from_raw(a).tet(), FaceRef::from_raw(b).tet()],
                                 });
                                 return;
                             }
-                            expect(&mut acc, a, FaceRef(b));
-                            expect(&mut acc, b, FaceRef(a));
-                            let (ra, rb) = (region(FaceRef(a).tet()), region(FaceRef(b).tet()));
+                            expect(&mut acc, a, FaceRef::from_raw(b));
+                            expect(&mut acc, b, FaceRef::from_raw(a));
+                            let (ra, rb) = (
+                                region(FaceRef::from_raw(a).tet()),
+                                region(FaceRef::from_raw(b).tet()),
+                            );
                             if ra == rb {
                                 acc.interior += 1;
                                 return;
@@ -388,7 +391,7 @@ impl TetMesh {
                         _ => {
                             acc.found.push(MeshProblem::FaceInManyTets {
                                 face,
-                                tets: g.iter().map(|&k| FaceRef(low(k)).tet()).collect(),
+                                tets: g.iter().map(|&k| FaceRef::from_raw(low(k)).tet()).collect(),
                             });
                             return;
                         }
@@ -397,7 +400,7 @@ impl TetMesh {
                         return;
                     }
                     // A boundary or interface face: it must be an input triangle.
-                    let fr = FaceRef(low(g[0]));
+                    let fr = FaceRef::from_raw(low(g[0]));
                     let r = find_triple(in_keys, unpack_triple(g[0]));
                     let tv = unpack_triple(g[0]);
                     if r.is_empty() {
@@ -409,7 +412,7 @@ impl TetMesh {
                             regions,
                         });
                     } else if regions.is_none() {
-                        let p = face_parity(tets, fr.0);
+                        let p = face_parity(tets, fr.raw());
                         if r.len() > 1 {
                             acc.found.push(MeshProblem::DuplicateInputTriangle {
                                 tris: r.iter().map(|&k| low(k) as usize).collect(),
@@ -464,13 +467,17 @@ impl TetMesh {
                 for_each_group(chunk, |g| {
                     let m = find_triple(keys, unpack_triple(g[0]));
                     let interface = m.len() == 2
-                        && region(FaceRef(low(m[0])).tet()) != region(FaceRef(low(m[1])).tet());
+                        && region(FaceRef::from_raw(low(m[0])).tet())
+                            != region(FaceRef::from_raw(low(m[1])).tet());
                     let why = match m.len() {
                         0 => Some("no tet has this face".to_string()),
                         2 if !interface
                             && face_parity(tets, low(m[0])) != face_parity(tets, low(m[1])) =>
                         {
-                            let (a, b) = (FaceRef(low(m[0])).tet(), FaceRef(low(m[1])).tet());
+                            let (a, b) = (
+                                FaceRef::from_raw(low(m[0])).tet(),
+                                FaceRef::from_raw(low(m[1])).tet(),
+                            );
                             Some(format!(
                                 "it lies inside region {}, between tets {a} and {b}",
                                 region(a)

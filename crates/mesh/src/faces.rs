@@ -53,7 +53,7 @@ pub(crate) fn low(k: u128) -> u32 {
 #[inline(always)]
 pub(crate) fn face_verts(tet: &[PointId; 4], f: usize) -> [u32; 3] {
     let l = TET_FACES[f];
-    [tet[l[0]].0, tet[l[1]].0, tet[l[2]].0]
+    [tet[l[0]].raw(), tet[l[1]].raw(), tet[l[2]].raw()]
 }
 
 /// True when the tet lists the same point twice; such a tet has no proper
@@ -140,7 +140,7 @@ pub(crate) fn find_triple(keys: &[u128], t: [u32; 3]) -> &[u128] {
 /// Parity of face `fr` as listed (outward from its tet).
 #[inline(always)]
 pub(crate) fn face_parity(tets: &[[PointId; 4]], fr: u32) -> bool {
-    let fr = FaceRef(fr);
+    let fr = FaceRef::from_raw(fr);
     sort3(face_verts(&tets[fr.tet().idx()], fr.local())).1
 }
 

@@ -108,7 +108,7 @@ pub fn box_mesh_two_regions(
     };
     let mut bnd: Vec<(u32, [PointId; 3])> = Vec::new();
     for (i, &n) in m.neigh.iter().enumerate() {
-        let f = FaceRef(i as u32);
+        let f = FaceRef::from_raw(i as u32);
         if n.is_none() {
             let v = m.face_points(f);
             bnd.push((side(v), v));

@@ -6,8 +6,18 @@ macro_rules! id_type {
         $(#[$m])*
         #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, PartialOrd, Ord)]
         #[repr(transparent)]
-        pub struct $name(pub u32);
+        pub struct $name(u32);
         impl $name {
+            /// From its raw `u32` (file formats, flat arrays).
+            #[inline(always)]
+            pub const fn from_raw(i: u32) -> Self {
+                $name(i)
+            }
+            /// Its raw `u32`.
+            #[inline(always)]
+            pub const fn raw(self) -> u32 {
+                self.0
+            }
             /// As an array index.
             #[inline(always)]
             pub fn idx(self) -> usize {

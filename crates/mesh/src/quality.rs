@@ -142,7 +142,10 @@ pub fn edge_size_ratios(mesh: &TetMesh, size: impl Fn(P3) -> f64 + Sync) -> Vec<
         .zip(mesh.tets.par_iter())
         .for_each(|(k, t)| {
             for (slot, e) in k.iter_mut().zip(TET_EDGES) {
-                let (a, b) = (t[e[0]].0.min(t[e[1]].0), t[e[0]].0.max(t[e[1]].0));
+                let (a, b) = (
+                    t[e[0]].raw().min(t[e[1]].raw()),
+                    t[e[0]].raw().max(t[e[1]].raw()),
+                );
                 *slot = if a != b && (b as usize) < np {
                     ((a as u64) << 32) | b as u64
                 } else {

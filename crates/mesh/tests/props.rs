@@ -39,7 +39,7 @@ fn rotation(q: [f64; 4]) -> Mat {
 }
 
 fn tris_of(m: &TetMesh) -> Vec<[u32; 3]> {
-    m.bnd_tris.iter().map(|t| t.map(|p| p.0)).collect()
+    m.bnd_tris.iter().map(|t| t.map(|p| p.raw())).collect()
 }
 
 proptest! {

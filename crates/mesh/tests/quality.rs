@@ -73,7 +73,7 @@ fn kuhn_tets_and_box_report() {
     // The Kuhn tet has dihedral angles 45, 60 and 90 degrees.
     assert!((r.min_dihedral.min - 45.0).abs() < 1e-9 && (r.min_dihedral.max - 45.0).abs() < 1e-9);
     assert!((r.max_dihedral.max - 90.0).abs() < 1e-9);
-    let mut d = dihedral_angles(m.tet_points(TetId(0)));
+    let mut d = dihedral_angles(m.tet_points(TetId::from_raw(0)));
     d.sort_by(f64::total_cmp);
     let want = [45.0, 45.0, 60.0, 90.0, 90.0, 90.0];
     for (a, b) in d.iter().zip(want) {
@@ -126,8 +126,12 @@ fn report_counts_bad_tets() {
     let mut m = box_mesh(2, 2, 2, [0.0; 3], [1.0; 3]);
     // Flatten a neighbourhood: the centre point onto a cell face plane.
     m.points[13] = [0.5, 0.5, 0.999];
-    m.tets
-        .push([PointId(0), PointId(1), PointId(2), PointId(99)]);
+    m.tets.push([
+        PointId::from_raw(0),
+        PointId::from_raw(1),
+        PointId::from_raw(2),
+        PointId::from_raw(99),
+    ]);
     let mut flipped = m.tets[0];
     flipped.swap(0, 1);
     m.tets.push(flipped);

@@ -483,11 +483,11 @@ fn merge_parts(
     for t in &mut tets {
         *t = t.map(|g| map[g as usize]);
     }
-    let typed: Vec<[PointId; 4]> = tets.iter().map(|t| t.map(PointId)).collect();
+    let typed: Vec<[PointId; 4]> = tets.iter().map(|t| t.map(PointId::from_raw)).collect();
     let neigh: Vec<u32> = parafront_mesh::face_neighbours(&typed)
         .map_err(PassError::DdgMerge)?
         .into_iter()
-        .map(|f| f.0)
+        .map(|f| f.raw())
         .collect();
     drop(typed);
     Ok((pts, tets, neigh))

@@ -56,7 +56,7 @@ fn serial_tets(s: &Surface, h: f64) -> usize {
 fn check(s: &Surface, o: &ParOutput) {
     let mut m = TetMesh {
         points: o.points.clone(),
-        tets: o.tets.iter().map(|t| t.map(PointId)).collect(),
+        tets: o.tets.iter().map(|t| t.map(PointId::from_raw)).collect(),
         region: vec![0; o.tets.len()],
         ..Default::default()
     };
@@ -250,7 +250,7 @@ fn the_ddg_built_in_parallel_is_valid_and_does_not_depend_on_the_threads() {
         );
         let mut m = TetMesh {
             points: a.points.clone(),
-            tets: a.tets.iter().map(|t| t.map(PointId)).collect(),
+            tets: a.tets.iter().map(|t| t.map(PointId::from_raw)).collect(),
             region: vec![0; a.tets.len()],
             ..Default::default()
         };

@@ -46,7 +46,7 @@ pub(crate) fn improve_around_lattice(
     let (mut kept, mut kept_region) = (Vec::new(), Vec::new());
     let (mut aside, mut aside_region) = (Vec::new(), Vec::new());
     for (t, &r) in mesh.tets.iter().zip(&mesh.region) {
-        let t = t.map(|p| PointId(new_id[p.idx()]));
+        let t = t.map(|p| PointId::from_raw(new_id[p.idx()]));
         if inert(&t) {
             aside.push(t);
             aside_region.push(r);

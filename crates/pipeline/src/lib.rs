@@ -397,7 +397,7 @@ pub fn bodies_in_material(shells: &[Shell]) -> Vec<usize> {
 fn surface_mesh(s: &Surface) -> TetMesh {
     TetMesh {
         points: s.points.clone(),
-        bnd_tris: s.tris.iter().map(|t| t.map(PointId)).collect(),
+        bnd_tris: s.tris.iter().map(|t| t.map(PointId::from_raw)).collect(),
         bnd_patch: s.patch.clone(),
         ..Default::default()
     }
@@ -561,7 +561,7 @@ fn append_region(
     mesh.points.extend_from_slice(&points[rf.points.len()..]);
     mesh.tets.extend(
         tets.iter()
-            .map(|t| t.map(|p| PointId(global_id(rf, base, p)))),
+            .map(|t| t.map(|p| PointId::from_raw(global_id(rf, base, p)))),
     );
     mesh.region
         .extend(std::iter::repeat_n(rf.region_id, tets.len()));

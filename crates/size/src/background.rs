@@ -71,7 +71,7 @@ impl BackgroundGrid {
         let np = mesh.points.len();
         let mut tets = Vec::with_capacity(mesh.tets.len());
         for (t, tet) in mesh.tets.iter().enumerate() {
-            let v = tet.map(|p| p.0);
+            let v = tet.map(|p| p.raw());
             if let Some(x) = v.iter().find(|&&x| x as usize >= np) {
                 return bad(format!(
                     "tet {t} refers to point {x}, but there are {np} points"

@@ -275,7 +275,7 @@ fn box_mesh() -> TetMesh {
                     if parafront_geom::orient3d(pt(v[0]), pt(v[1]), pt(v[2]), pt(v[3])) < 0.0 {
                         v.swap(2, 3);
                     }
-                    m.tets.push([v[0], v[1], v[2], v[3]].map(PointId));
+                    m.tets.push([v[0], v[1], v[2], v[3]].map(PointId::from_raw));
                 }
             }
         }

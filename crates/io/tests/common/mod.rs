@@ -42,10 +42,10 @@ pub fn cube_mesh(n: usize, region: impl Fn(usize) -> u32) -> TetMesh {
             for k in 0..n {
                 for pm in perms {
                     let mut c = [i, j, k];
-                    let mut t = [PointId(id(c[0], c[1], c[2]) as u32); 4];
+                    let mut t = [PointId::from_raw(id(c[0], c[1], c[2]) as u32); 4];
                     for s in 0..3 {
                         c[pm[s]] += 1;
-                        t[s + 1] = PointId(id(c[0], c[1], c[2]) as u32);
+                        t[s + 1] = PointId::from_raw(id(c[0], c[1], c[2]) as u32);
                     }
                     let p = |v: PointId| m.points[v.idx()];
                     if orient3d(p(t[0]), p(t[1]), p(t[2]), p(t[3])) < 0.0 {
@@ -63,7 +63,7 @@ pub fn cube_mesh(n: usize, region: impl Fn(usize) -> u32) -> TetMesh {
     for t in &m.tets {
         for f in TET_FACES {
             let tri = [t[f[0]], t[f[1]], t[f[2]]];
-            let mut key = tri.map(|p| p.0);
+            let mut key = tri.map(|p| p.raw());
             key.sort_unstable();
             count.entry(key).or_insert((0, tri)).0 += 1;
         }
