@@ -40,15 +40,15 @@ impl Ddg {
             for f in 0..4 {
                 let fr = (4 * t + f) as u32;
                 let nb = self.neigh[fr as usize];
-                if nb == u32::MAX {
+                if nb.is_none() {
                     continue;
                 }
-                let u = (nb >> 2) as usize;
-                if u >= self.tets.len() || self.neigh[nb as usize] != fr {
+                let u = nb.tet().idx();
+                if u >= self.tets.len() || self.neigh[nb.idx()].raw() != fr {
                     return Err(DdgCheckError::Asymmetric(fr));
                 }
                 let w = TET_FACES[f].map(|k| tv[k]);
-                let x = TET_FACES[(nb & 3) as usize].map(|k| self.tets[u][k]);
+                let x = TET_FACES[nb.local()].map(|k| self.tets[u][k]);
                 let turned = [x[0], x[2], x[1]];
                 let same = w == turned
                     || w == [turned[1], turned[2], turned[0]]
@@ -78,11 +78,14 @@ mod tests {
         let fr = d
             .neigh
             .iter()
-            .position(|&n| n != u32::MAX)
+            .position(|n| !n.is_none())
             .expect("inner faces");
         let mut bad = d.clone();
-        bad.neigh[fr] = u32::MAX;
-        assert_eq!(bad.check(), Err(DdgCheckError::Asymmetric(d.neigh[fr])));
+        bad.neigh[fr] = parafront_mesh::NO_FACE;
+        assert_eq!(
+            bad.check(),
+            Err(DdgCheckError::Asymmetric(d.neigh[fr].raw()))
+        );
         let mut bad = d.clone();
         bad.tets[0].swap(0, 1);
         assert!(matches!(

@@ -22,6 +22,7 @@ pub use partition::{
 
 use parafront_front::{advance, Everywhere, FrontError, FrontInput, FrontOptions, SizeMode};
 use parafront_geom::P3;
+use parafront_mesh::FaceRef;
 use std::time::Instant;
 
 /// Default growth factor `c_i` (§5: typical values 1.5 to 1.7).
@@ -35,8 +36,8 @@ pub struct Ddg {
     pub points: Vec<P3>,
     /// Point ids of each tet, as the front made them.
     pub tets: Vec<[u32; 4]>,
-    /// `neigh[4t+f]` = `4t'+f'` or `u32::MAX` (from the front).
-    pub neigh: Vec<u32>,
+    /// The tet across each face, `neigh[4t+f]` (or `NO_FACE`).
+    pub neigh: Vec<FaceRef>,
     /// Points of the input front.
     pub n_input: usize,
     /// The growth factor.

@@ -293,10 +293,10 @@ impl Interfaces {
         for t in 0..d.tets.len() {
             for f in 0..4 {
                 let n = d.neigh[4 * t + f];
-                if n == u32::MAX {
+                if n.is_none() {
                     continue; // the surface: the front itself stops there
                 }
-                let u = (n / 4) as usize;
+                let u = n.tet().idx();
                 if u < t || part[u] == part[t] {
                     continue;
                 }

@@ -251,8 +251,8 @@ pub(crate) fn dual_graph(d: &Ddg) -> (Vec<i32>, Vec<i32>) {
     for t in 0..d.tets.len() {
         for f in 0..4 {
             let n = d.neigh[4 * t + f];
-            if n != u32::MAX {
-                adj.push((n / 4) as i32);
+            if !n.is_none() {
+                adj.push(n.tet().raw() as i32);
             }
         }
         xadj.push(adj.len() as i32);
@@ -330,7 +330,7 @@ pub(crate) fn metis_kway(
             let mut x = [0.0; 4];
             for (f, xf) in x.iter_mut().enumerate() {
                 let nb = d.neigh[4 * t + f];
-                if nb != u32::MAX && (nb / 4) as usize > t {
+                if !nb.is_none() && nb.tet().idx() > t {
                     *xf = fine_faces(d, h, t, f);
                 }
             }
@@ -341,8 +341,8 @@ pub(crate) fn metis_kway(
     for t in 0..n {
         for f in 0..4 {
             let nb = d.neigh[4 * t + f];
-            if nb != u32::MAX {
-                let (u, g) = ((nb / 4) as usize, (nb % 4) as usize);
+            if !nb.is_none() {
+                let (u, g) = (nb.tet().idx(), nb.local());
                 ew.push(if u > t { fw[t][f] } else { fw[u][g] });
             }
         }
@@ -381,7 +381,7 @@ pub fn cut_faces(d: &Ddg, part: &[u32]) -> usize {
     for t in 0..d.tets.len() {
         for f in 0..4 {
             let n = d.neigh[4 * t + f];
-            if n != u32::MAX && ((n / 4) as usize) > t && part[(n / 4) as usize] != part[t] {
+            if !n.is_none() && (n.tet().idx()) > t && part[n.tet().idx()] != part[t] {
                 cut += 1;
             }
         }
@@ -396,7 +396,7 @@ pub fn cut_fine_faces(d: &Ddg, part: &[u32], h: &(dyn Fn(P3) -> f64 + Sync)) -> 
     for t in 0..d.tets.len() {
         for f in 0..4 {
             let n = d.neigh[4 * t + f];
-            if n != u32::MAX && ((n / 4) as usize) > t && part[(n / 4) as usize] != part[t] {
+            if !n.is_none() && (n.tet().idx()) > t && part[n.tet().idx()] != part[t] {
                 cut += fine_faces(d, h, t, f);
             }
         }
@@ -422,10 +422,10 @@ pub fn components(d: &Ddg, part: &[u32], parts: usize) -> Vec<usize> {
         while let Some(t) = stack.pop() {
             for f in 0..4 {
                 let nb = d.neigh[4 * t + f];
-                if nb == u32::MAX {
+                if nb.is_none() {
                     continue;
                 }
-                let u = (nb / 4) as usize;
+                let u = nb.tet().idx();
                 if !seen[u] && part[u] == k {
                     seen[u] = true;
                     stack.push(u);
@@ -641,7 +641,7 @@ mod tests {
                 for t in 0..d.tets.len() {
                     for f in 0..4 {
                         let n = d.neigh[4 * t + f];
-                        if n != u32::MAX && ((n / 4) as usize) > t && p[(n / 4) as usize] != p[t] {
+                        if !n.is_none() && (n.tet().idx()) > t && p[n.tet().idx()] != p[t] {
                             v.push((t, f));
                         }
                     }
@@ -681,7 +681,7 @@ mod tests {
                     (0..4)
                         .filter(|&f| {
                             let n = d.neigh[4 * t + f];
-                            n != u32::MAX && raw[(n / 4) as usize] != raw[t]
+                            !n.is_none() && raw[n.tet().idx()] != raw[t]
                         })
                         .count() as u32
                 })

@@ -25,11 +25,7 @@ fn fill(s: &Surface, h: f64) -> (TetMesh, FrontStats) {
         region: vec![0; r.tets.len()],
         ..Default::default()
     };
-    m.neigh = r
-        .neigh
-        .iter()
-        .map(|&f| parafront_mesh::FaceRef::from_raw(f))
-        .collect();
+    m.neigh = r.neigh.clone();
     let stats = m
         .check_against_surface(&s.tris)
         .unwrap_or_else(|e| panic!("invalid mesh: {e}"));

@@ -454,7 +454,7 @@ fn merge_parts(
     parts: Vec<Part>,
     n_input: usize,
     n: usize,
-) -> Result<(Vec<P3>, Vec<[u32; 4]>, Vec<u32>), PassError> {
+) -> Result<(Vec<P3>, Vec<[u32; 4]>, Vec<parafront_mesh::FaceRef>), PassError> {
     let mut at: Vec<P3> = vec![[0.0; 3]; n];
     let mut used = vec![false; n];
     used[..n_input].iter_mut().for_each(|u| *u = true);
@@ -484,11 +484,7 @@ fn merge_parts(
         *t = t.map(|g| map[g as usize]);
     }
     let typed: Vec<[PointId; 4]> = tets.iter().map(|t| t.map(PointId::from_raw)).collect();
-    let neigh: Vec<u32> = parafront_mesh::face_neighbours(&typed)
-        .map_err(PassError::DdgMerge)?
-        .into_iter()
-        .map(|f| f.raw())
-        .collect();
+    let neigh = parafront_mesh::face_neighbours(&typed).map_err(PassError::DdgMerge)?;
     drop(typed);
     Ok((pts, tets, neigh))
 }

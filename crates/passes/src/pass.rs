@@ -211,7 +211,7 @@ pub(crate) fn seed_inner_parts(
     for t in 0..nt {
         let wall = (0..4).any(|f| {
             let n = d.neigh[4 * t + f];
-            n == u32::MAX || part0[(n / 4) as usize] != part0[t]
+            n.is_none() || part0[n.tet().idx()] != part0[t]
         });
         if wall {
             depth[t] = 0;
@@ -221,9 +221,9 @@ pub(crate) fn seed_inner_parts(
     while let Some(t) = queue.pop_front() {
         for f in 0..4 {
             let n = d.neigh[4 * t + f];
-            if n != u32::MAX && depth[(n / 4) as usize] == u32::MAX {
-                depth[(n / 4) as usize] = depth[t] + 1;
-                queue.push_back((n / 4) as usize);
+            if !n.is_none() && depth[n.tet().idx()] == u32::MAX {
+                depth[n.tet().idx()] = depth[t] + 1;
+                queue.push_back(n.tet().idx());
             }
         }
     }

@@ -271,9 +271,9 @@ fn the_ddg_built_in_parallel_is_valid_and_does_not_depend_on_the_threads() {
         for (t, tv) in a.tets.iter().enumerate() {
             for f in 0..4 {
                 let n = a.neigh[4 * t + f];
-                if n != u32::MAX {
-                    assert_eq!(a.neigh[n as usize], (4 * t + f) as u32);
-                    let u = a.tets[(n / 4) as usize];
+                if !n.is_none() {
+                    assert_eq!(a.neigh[n.idx()].raw(), (4 * t + f) as u32);
+                    let u = a.tets[n.tet().idx()];
                     let shared = tv.iter().filter(|p| u.contains(p)).count();
                     assert_eq!(shared, 3);
                 }

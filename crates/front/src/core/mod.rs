@@ -168,8 +168,8 @@ pub struct FrontResult {
     pub point_size: Vec<f64>,
     /// Positively oriented tets.
     pub tets: Vec<[u32; 4]>,
-    /// `neigh[4t+f] = 4t'+f'` or `u32::MAX`.
-    pub neigh: Vec<u32>,
+    /// The tet across each face, `neigh[4t+f]` (or `NO_FACE`).
+    pub neigh: Vec<parafront_mesh::FaceRef>,
     /// Faces the region filter kept from being advanced, and in pass mode
     /// the faces that got stuck (pass hand-over).
     pub front: Vec<[u32; 3]>,
@@ -735,7 +735,11 @@ impl<'a> Front<'a> {
             points,
             point_size,
             tets,
-            neigh,
+            // In place: `FaceRef` is a transparent `u32`, `NONE` its `NO_FACE`.
+            neigh: neigh
+                .into_iter()
+                .map(parafront_mesh::FaceRef::from_raw)
+                .collect(),
             front: front.iter().map(|f| f.map(|p| pmap[p as usize])).collect(),
             stats,
         }
