@@ -350,6 +350,58 @@ impl Part {
             h: self.size[i as usize],
         }
     }
+
+    /// The part's invariants, for the tests and debug builds (after every
+    /// pass): one point record per local id, the index maps each global
+    /// id to its local one and nothing else, every tet and face names local
+    /// points (distinct ones), and each tet has the pass that made it.
+    fn check(&self) -> Result<(), PartCheckError> {
+        let n = self.pts.len();
+        if self.size.len() != n || self.gid.len() != n || self.index.len() != n {
+            return Err(PartCheckError::Lengths);
+        }
+        if let Some(i) = (0..n).find(|&i| self.index.get(&self.gid[i]) != Some(&(i as u32))) {
+            return Err(PartCheckError::Index(self.gid[i]));
+        }
+        if self.tet_pass.len() != self.tets.len() {
+            return Err(PartCheckError::Lengths);
+        }
+        let bad = |v: &[u32]| {
+            v.iter().any(|&i| i as usize >= n)
+                || (0..v.len()).any(|a| (a + 1..v.len()).any(|b| v[a] == v[b]))
+        };
+        if let Some(t) = self.tets.iter().position(|t| bad(t)) {
+            return Err(PartCheckError::Tet(t));
+        }
+        if let Some(f) = self.front.iter().position(|f| bad(f)) {
+            return Err(PartCheckError::Face(f));
+        }
+        Ok(())
+    }
+}
+
+/// What [`Part::check`] found wrong.
+#[derive(Debug, PartialEq, Eq, thiserror::Error)]
+enum PartCheckError {
+    #[error("the part's per-point or per-tet arrays differ in length")]
+    Lengths,
+    #[error("the part's index does not map global point {0} to its local id")]
+    Index(u32),
+    #[error("the part's tet {0} names a missing point or repeats one")]
+    Tet(usize),
+    #[error("the part's front face {0} names a missing point or repeats one")]
+    Face(usize),
+}
+
+/// [`Part::check`] on every part, in debug builds.
+fn debug_check_parts(parts: &[Part], after: &str) {
+    if cfg!(debug_assertions) {
+        for (k, p) in parts.iter().enumerate() {
+            if let Err(e) = p.check() {
+                panic!("part {k} after {after}: {e}");
+            }
+        }
+    }
 }
 
 /// What one part's front call gave back, before new points get global ids.
@@ -475,6 +527,7 @@ pub fn mesh_parallel<C: Comm>(
         opts.fill_after,
     )?;
     rec.pass4(made4, removed, t0.elapsed().as_secs_f64());
+    debug_check_parts(&parts, "pass 4");
 
     // §8 step 4.
     let t0 = Instant::now();
@@ -604,5 +657,41 @@ fn left_fraction<C: Comm>(parts: &[Part], comm: &C, points: &[P3], faces: &[[u32
         left / all
     } else {
         0.0
+    }
+}
+
+#[cfg(test)]
+mod part_check_tests {
+    use super::*;
+
+    #[test]
+    fn a_sound_part_passes_and_each_fault_is_named() {
+        let mut p = Part::default();
+        let ids: Vec<u32> = (0..4)
+            .map(|g| {
+                p.local(Rec {
+                    gid: 10 + g,
+                    p: [g as f64, 0.0, 0.0],
+                    h: 1.0,
+                })
+            })
+            .collect();
+        p.tets.push([ids[0], ids[1], ids[2], ids[3]]);
+        p.tet_pass.push(1);
+        p.front.push([ids[0], ids[2], ids[1]]);
+        assert_eq!(p.check(), Ok(()));
+        p.tets[0][3] = ids[0];
+        assert_eq!(p.check(), Err(PartCheckError::Tet(0)));
+        p.tets[0][3] = 9;
+        assert_eq!(p.check(), Err(PartCheckError::Tet(0)));
+        p.tets[0][3] = ids[3];
+        p.front[0][1] = 7;
+        assert_eq!(p.check(), Err(PartCheckError::Face(0)));
+        p.front[0][1] = ids[2];
+        p.index.insert(10, 3);
+        assert_eq!(p.check(), Err(PartCheckError::Index(10)));
+        p.index.insert(10, 0);
+        p.tet_pass.clear();
+        assert_eq!(p.check(), Err(PartCheckError::Lengths));
     }
 }
