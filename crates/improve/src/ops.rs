@@ -412,14 +412,7 @@ impl Work<'_> {
     /// is kept only when no tet inverts and the ball's worst quality does
     /// not drop (and its mean rises).
     pub(crate) fn smooth_point(&mut self, p: PointId, s: &mut Scratch) -> Outcome {
-        if let Some(o) = self.pinned(p) {
-            return o;
-        }
-        let mut ball = std::mem::take(&mut s.ball);
-        self.ball(p, &mut ball);
-        let out = self.smooth_in(p, &ball, s);
-        s.ball = ball;
-        out
+        self.on_ball(p, s, |w, ball, s| w.smooth_in(p, ball, s))
     }
 
     fn smooth_in(&mut self, p: PointId, ball: &[u32], s: &mut Scratch) -> Outcome {
@@ -488,25 +481,41 @@ impl Work<'_> {
         }
     }
 
-    /// Moves free point `p` to `pos` if no tet inverts and the worst
-    /// quality of its ball does not drop.
-    pub(crate) fn try_move(&mut self, p: PointId, pos: P3, s: &mut Scratch) -> Outcome {
+    /// The moves' frame: `op` on free point `p`'s ball, taken from the
+    /// scratch and put back (a pinned point is not moved).
+    #[inline(always)]
+    fn on_ball(
+        &mut self,
+        p: PointId,
+        s: &mut Scratch,
+        op: impl FnOnce(&mut Self, &[u32], &mut Scratch) -> Outcome,
+    ) -> Outcome {
         if let Some(o) = self.pinned(p) {
             return o;
         }
         let mut ball = std::mem::take(&mut s.ball);
         self.ball(p, &mut ball);
-        let qmin = self.ball_qmin(&ball);
-        let out = match self.ball_quality_above(p, pos, &ball, qmin) {
+        let out = op(self, &ball, s);
+        s.ball = ball;
+        out
+    }
+
+    /// Moves free point `p` to `pos` if no tet inverts and the worst
+    /// quality of its ball does not drop.
+    pub(crate) fn try_move(&mut self, p: PointId, pos: P3, s: &mut Scratch) -> Outcome {
+        self.on_ball(p, s, |w, ball, _| w.try_move_in(p, pos, ball))
+    }
+
+    fn try_move_in(&mut self, p: PointId, pos: P3, ball: &[u32]) -> Outcome {
+        let qmin = self.ball_qmin(ball);
+        match self.ball_quality_above(p, pos, ball, qmin) {
             BallQ::Inverted => Outcome::Inverted,
             BallQ::Below => Outcome::NotBetter,
             BallQ::Ok(..) => {
-                self.commit_move(p, pos, &ball);
+                self.commit_move(p, pos, ball);
                 Outcome::Done
             }
-        };
-        s.ball = ball;
-        out
+        }
     }
 
     /// §9.4 selective movement: try `p` along each of its edges, both ways,
@@ -514,13 +523,12 @@ impl Work<'_> {
     /// raises the worst quality of the ball and the ball's mean quality
     /// drops by at most [`SELECTIVE_TRADE`] times that gain.
     pub(crate) fn selective_move(&mut self, p: PointId, s: &mut Scratch) -> Outcome {
-        if let Some(o) = self.pinned(p) {
-            return o;
-        }
-        let mut ball = std::mem::take(&mut s.ball);
-        self.ball(p, &mut ball);
-        self.neighbours(p, &ball, &mut s.nb);
-        let qmin = self.ball_qmin(&ball);
+        self.on_ball(p, s, |w, ball, s| w.selective_move_in(p, ball, s))
+    }
+
+    fn selective_move_in(&mut self, p: PointId, ball: &[u32], s: &mut Scratch) -> Outcome {
+        self.neighbours(p, ball, &mut s.nb);
+        let qmin = self.ball_qmin(ball);
         let p0 = self.m.points[p.idx()];
         let mean0 = ball.iter().map(|&t| self.q[t as usize]).sum::<f64>() / ball.len() as f64;
         let mut best: Option<(f64, P3)> = None;
@@ -529,22 +537,20 @@ impl Work<'_> {
             for f in [0.25, 0.1, 0.03, -0.03, -0.1, -0.25] {
                 let pos = [0, 1, 2].map(|k| p0[k] + f * d[k]);
                 let floor = best.map_or(qmin, |b| b.0);
-                if let BallQ::Ok(m, mean) = self.ball_quality_above(p, pos, &ball, floor) {
+                if let BallQ::Ok(m, mean) = self.ball_quality_above(p, pos, ball, floor) {
                     if beats(m, floor) && mean >= mean0 - SELECTIVE_TRADE * (m - qmin) {
                         best = Some((m, pos));
                     }
                 }
             }
         }
-        let out = match best {
+        match best {
             Some((_, pos)) => {
-                self.commit_move(p, pos, &ball);
+                self.commit_move(p, pos, ball);
                 Outcome::Done
             }
             None => Outcome::NotBetter,
-        };
-        s.ball = ball;
-        out
+        }
     }
 
     /// The last polish for the min dihedral (§9.4's selective movement,
@@ -556,19 +562,24 @@ impl Work<'_> {
     /// the mean ratio is best but their dihedral is not: on skull.obj a
     /// tenth of the worst mean ratio buys 0.14° -> 0.22°.
     pub(crate) fn dihedral_move(&mut self, p: PointId, keep: f64, s: &mut Scratch) -> Outcome {
-        if let Some(o) = self.pinned(p) {
-            return o;
-        }
-        let mut ball = std::mem::take(&mut s.ball);
-        self.ball(p, &mut ball);
-        self.neighbours(p, &ball, &mut s.nb);
-        let floor = keep * self.ball_qmin(&ball);
+        self.on_ball(p, s, |w, ball, s| w.dihedral_move_in(p, keep, ball, s))
+    }
+
+    fn dihedral_move_in(
+        &mut self,
+        p: PointId,
+        keep: f64,
+        ball: &[u32],
+        s: &mut Scratch,
+    ) -> Outcome {
+        self.neighbours(p, ball, &mut s.nb);
+        let floor = keep * self.ball_qmin(ball);
         // (min dihedral, tets under 10°) of the ball with p at pos, when no
         // tet inverts or falls under the mean ratio floor.
         let eval = |w: &Self, pos: P3| -> Option<(f64, usize)> {
             let mut d = f64::INFINITY;
             let mut under = 0;
-            for &t in &ball {
+            for &t in ball {
                 let x = w.pts_moved(t, p, pos);
                 if positive_quality(x).is_none_or(|q| q < floor) {
                     return None;
@@ -586,7 +597,6 @@ impl Work<'_> {
                 .sum::<f64>()
                 / s.nb.len().max(1) as f64;
         let Some((d0, under0)) = eval(self, p0) else {
-            s.ball = ball;
             return Outcome::NotBetter;
         };
         // No more tets under 10° than before: the share under 10° is the
@@ -600,32 +610,29 @@ impl Work<'_> {
             |c, _| eval(self, c).filter(|e| e.1 <= under0).map(|e| e.0),
             |d, cur| *d > *cur + 1e-9,
         );
-        let out = if best > d0 * (1.0 + MARGIN) + 1e-9 {
-            self.commit_move(p, pos, &ball);
+        if best > d0 * (1.0 + MARGIN) + 1e-9 {
+            self.commit_move(p, pos, ball);
             Outcome::Done
         } else {
             Outcome::NotBetter
-        };
-        s.ball = ball;
-        out
+        }
     }
 
     /// Moves free point `p` by a compass search to leave fewer tets of its
     /// ball under 10°, with a min dihedral no lower (the issue's
     /// measure is the point here, not the mean ratio; see `insert.rs`).
     pub(crate) fn count_move(&mut self, p: PointId, s: &mut Scratch) -> Outcome {
-        if let Some(o) = self.pinned(p) {
-            return o;
-        }
-        let mut ball = std::mem::take(&mut s.ball);
-        self.ball(p, &mut ball);
-        self.neighbours(p, &ball, &mut s.nb);
+        self.on_ball(p, s, |w, ball, s| w.count_move_in(p, ball, s))
+    }
+
+    fn count_move_in(&mut self, p: PointId, ball: &[u32], s: &mut Scratch) -> Outcome {
+        self.neighbours(p, ball, &mut s.nb);
         // (tets under 10°, shortfall below 12°, min dihedral) with p at pos;
         // None when a tet inverts, more than `cap` are under 10° or one is
         // under `floor` (the search's bounds, checked as it goes).
         let eval = |w: &Self, pos: P3, cap: usize, floor: f64| -> Option<(usize, f64, f64)> {
             let (mut under, mut short, mut dmin) = (0, 0.0, f64::INFINITY);
-            for &t in &ball {
+            for &t in ball {
                 let x = w.pts_moved(t, p, pos);
                 let d = min_dihedral_deg(x);
                 under += usize::from(d < crate::insert::SMALL_DIHEDRAL);
@@ -646,7 +653,6 @@ impl Work<'_> {
                 .map(|x| dist2(self.m.points[x.idx()], p0).sqrt())
                 .fold(f64::INFINITY, f64::min);
         let Some(e0) = eval(self, p0, usize::MAX, f64::NEG_INFINITY) else {
-            s.ball = ball;
             return Outcome::NotBetter;
         };
         let (best, pos) = compass(
@@ -658,13 +664,11 @@ impl Work<'_> {
             |c, cur| eval(self, c, cur.0, e0.2),
             |a, b| better(*a, *b),
         );
-        let out = if best.0 < e0.0 {
-            self.commit_move(p, pos, &ball);
+        if best.0 < e0.0 {
+            self.commit_move(p, pos, ball);
             Outcome::Done
         } else {
             Outcome::NotBetter
-        };
-        s.ball = ball;
-        out
+        }
     }
 }
