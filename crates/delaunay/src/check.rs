@@ -6,16 +6,23 @@ use parafront_geom::orient3d;
 /// What [`Triangulation::check`] found wrong.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum CheckError {
+    /// Live tet `.0` is not positively oriented (exactly).
     #[error("tet {0} is not positive")]
     NotPositive(u32),
+    /// Face `.1` of tet `.0` links to a neighbour face that does not link back.
     #[error("tet {0} face {1}: its neighbour does not point back")]
     Asymmetric(u32, usize),
+    /// Face `.1` of tet `.0` and its neighbour's face have different corners.
     #[error("tet {0} face {1}: the neighbour's face has other corners")]
     Mismatch(u32, usize),
+    /// Tet `.0` links to a dead tet.
     #[error("tet {0} links to a dead tet")]
     DeadLink(u32),
+    /// Face `.1` of tet `.0` is not locally Delaunay: the neighbour's apex lies
+    /// inside the tet's circumsphere (under the symbolic perturbation).
     #[error("tet {0} face {1}: the neighbour's apex is inside its circumsphere")]
     NotDelaunay(u32, usize),
+    /// `.0` faces have no neighbour; exactly the bounding tet's four should.
     #[error("{0} faces lie on the bounding hull, a closed hull has 4")]
     OpenHull(usize),
 }

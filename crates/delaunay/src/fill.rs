@@ -66,6 +66,7 @@ pub struct Fill {
     /// Positive tets. Ids below `points.len()` are the caller's points;
     /// id `points.len() + k` is `steiner[k]`.
     pub tets: Vec<[u32; 4]>,
+    /// Which method made the tets.
     pub method: FillMethod,
     /// Flips the recovery made.
     pub flips: usize,
@@ -74,22 +75,38 @@ pub struct Fill {
 /// Why a cavity was not filled.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum FillError {
+    /// `faces` is empty.
     #[error("the cavity has no faces")]
     Empty,
+    /// Face `.0` names point `.1`, which is not in `points`.
     #[error("cavity face {0} names point {1}, which does not exist")]
     BadIndex(usize, u32),
+    /// Face `.0` names a point twice.
     #[error("cavity face {0} repeats a corner")]
     Degenerate(usize),
+    /// Edge `.0`-`.1` (lower id first) is not used as often in each direction,
+    /// so the faces do not close a cavity.
     #[error("cavity edge {0}-{1} is not used as often in each direction")]
     NotClosed(u32, u32),
+    /// The faces enclose no positive volume (their normals point out, or the
+    /// cavity is flat).
     #[error("the cavity's faces enclose no positive volume")]
     NotPositive,
+    /// A point could not be inserted into the triangulation.
     #[error(transparent)]
     Insert(#[from] InsertError),
+    /// No method filled the cavity: flips left faces missing, no interior point
+    /// sees every face, and the search and the Steiner points (where tried)
+    /// failed.
     #[error(
         "{missing} of {faces} cavity faces could not be recovered, and no point sees them all"
     )]
-    Unrecovered { missing: usize, faces: usize },
+    Unrecovered {
+        /// Cavity faces still missing from the last triangulation tried.
+        missing: usize,
+        /// Cavity faces in all.
+        faces: usize,
+    },
 }
 
 /// Fill the cavity bounded by `faces` (triangles of `points`, each with its

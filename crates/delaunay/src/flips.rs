@@ -9,6 +9,7 @@ use rustc_hash::{FxHashMap, FxHashSet};
 /// What a local operation did.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Flip {
+    /// Done: the new tets, each positive, replace the old ones.
     Done,
     /// A new tet would not be positive.
     NotConvex,

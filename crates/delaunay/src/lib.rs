@@ -18,6 +18,7 @@
 //! Steiner points strictly inside the cavity at its dead ends), then Steiner
 //! points in the triangulation.
 #![forbid(unsafe_code)]
+#![warn(missing_docs)]
 mod check;
 mod fill;
 mod flips;

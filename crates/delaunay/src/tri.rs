@@ -14,10 +14,13 @@ pub const TET_FACES: [[usize; 3]; 4] = [[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 
 /// Why a point was not inserted.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum InsertError {
+    /// A coordinate is NaN or infinite.
     #[error("point {0:?} is not finite")]
     NotFinite(P3),
+    /// The point lies outside the bounding tet.
     #[error("point {0:?} lies outside the bounding tet")]
     Outside(P3),
+    /// The point coincides exactly with point `.1` (a triangulation id).
     #[error("point {0:?} coincides with point {1}")]
     Duplicate(P3, u32),
 }
@@ -115,6 +118,8 @@ impl Triangulation {
         })
     }
 
+    /// Every point, by triangulation id: the bounding tet's four corners, then
+    /// the points given to [`Triangulation::new`] and any inserted after them.
     pub fn points(&self) -> &[P3] {
         &self.pts
     }
@@ -126,12 +131,18 @@ impl Triangulation {
     pub fn tet_slots(&self) -> usize {
         self.tets.len()
     }
+    /// The corners of tet slot `t` (meaningful only while it is alive), ordered
+    /// so the tet is positive.
     pub fn tet(&self, t: u32) -> [u32; 4] {
         self.tets[t as usize]
     }
+    /// Whether tet slot `t` holds a live tet (dead slots wait for reuse).
     pub fn is_alive(&self, t: u32) -> bool {
         self.alive[t as usize]
     }
+    /// The face across face `f` of tet `t` (face `f` is opposite corner `f`), as
+    /// a `4u+g` reference to face `g` of tet `u`, or [`NONE`] on the bounding
+    /// tet's hull.
     pub fn neighbour(&self, t: u32, f: usize) -> u32 {
         self.neigh[4 * t as usize + f]
     }

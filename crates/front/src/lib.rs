@@ -9,6 +9,7 @@
 //! their `4t+f` adjacency (kept as tets are made, not rebuilt), the new
 //! points and whatever front a region filter left behind.
 
+#![warn(missing_docs)]
 mod core;
 mod grid;
 mod quality;
@@ -63,6 +64,7 @@ use parafront_geom::P3;
 /// Where a pass may mesh (paper §7). The front skips faces whose points,
 /// edges or ideal point fall outside, and drops close points outside.
 pub trait RegionFilter: Sync {
+    /// Whether `p` lies inside the region (by default everywhere).
     fn point_ok(&self, _p: P3) -> bool {
         true
     }

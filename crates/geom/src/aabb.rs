@@ -1,9 +1,13 @@
 //! Axis-aligned bounding boxes.
 use crate::P3;
 
+/// An axis-aligned box, closed on every side; [`Aabb::EMPTY`] (min above max)
+/// stands for the box that holds nothing.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Aabb {
+    /// The lowest corner, per axis.
     pub min: P3,
+    /// The highest corner, per axis.
     pub max: P3,
 }
 
@@ -14,6 +18,7 @@ impl Aabb {
         max: [f64::NEG_INFINITY; 3],
     };
 
+    /// The smallest box holding every point given; [`Aabb::EMPTY`] for none.
     pub fn from_points<'a>(pts: impl IntoIterator<Item = &'a P3>) -> Aabb {
         let mut b = Aabb::EMPTY;
         for p in pts {
@@ -21,6 +26,7 @@ impl Aabb {
         }
         b
     }
+    /// Widens the box to hold `p`.
     #[inline]
     pub fn grow(&mut self, p: P3) {
         for k in 0..3 {
@@ -28,6 +34,7 @@ impl Aabb {
             self.max[k] = self.max[k].max(p[k]);
         }
     }
+    /// The smallest box holding both boxes.
     #[inline]
     pub fn union(&self, o: &Aabb) -> Aabb {
         let mut b = *self;
@@ -37,6 +44,7 @@ impl Aabb {
         }
         b
     }
+    /// Whether the two closed boxes share a point (touching counts).
     #[inline]
     pub fn overlaps(&self, o: &Aabb) -> bool {
         (0..3).all(|k| self.min[k] <= o.max[k] && o.min[k] <= self.max[k])
@@ -50,13 +58,18 @@ impl Aabb {
         }
         r
     }
+    /// Whether `p` lies in the closed box.
     #[inline]
     pub fn contains(&self, p: P3) -> bool {
         (0..3).all(|k| self.min[k] <= p[k] && p[k] <= self.max[k])
     }
+    /// Whether the box holds no point, as [`Aabb::EMPTY`] does until a point is
+    /// added. Only the x extent is tested: `grow` and `union` leave a box empty
+    /// on every axis or on none.
     pub fn is_empty(&self) -> bool {
         self.min[0] > self.max[0]
     }
+    /// The length of the box's diagonal, 0 for the empty box.
     pub fn diagonal(&self) -> f64 {
         if self.is_empty() {
             0.0
@@ -64,6 +77,7 @@ impl Aabb {
             crate::vec3::dist(self.min, self.max)
         }
     }
+    /// The midpoint of the box (not meaningful for the empty box).
     pub fn center(&self) -> P3 {
         [
             0.5 * (self.min[0] + self.max[0]),

@@ -3,6 +3,7 @@
 //! crossing tests, the mesh `check()`) decides topology only through the
 //! exact predicates here, never through a float tolerance.
 #![forbid(unsafe_code)]
+#![warn(missing_docs)]
 
 pub mod aabb;
 pub mod intersect;

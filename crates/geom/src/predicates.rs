@@ -7,14 +7,19 @@
 use crate::P3;
 use robust::{Coord, Coord3D};
 
+/// The sign of a predicate's value, for callers that branch three ways.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Sign {
+    /// Strictly below zero.
     Negative,
+    /// Exactly zero: the points are degenerate (coplanar, cospherical, ...).
     Zero,
+    /// Strictly above zero.
     Positive,
 }
 
 impl Sign {
+    /// The sign of `x`; NaN maps to [`Sign::Zero`].
     #[inline(always)]
     pub fn of(x: f64) -> Sign {
         if x > 0.0 {
@@ -53,6 +58,8 @@ pub fn orient3d(a: P3, b: P3, c: P3, d: P3) -> f64 {
     -robust::orient3d(c3(a), c3(b), c3(c), c3(d))
 }
 
+/// The exact sign of [`orient3d`]: positive when tet `abcd` is right-handed
+/// (positive volume), zero when the four points are coplanar.
 #[inline]
 pub fn orient3d_sign(a: P3, b: P3, c: P3, d: P3) -> Sign {
     Sign::of(orient3d(a, b, c, d))

@@ -1,22 +1,27 @@
 //! Small vector helpers on `[f64; 3]`.
 use crate::P3;
 
+/// The difference `a - b`.
 #[inline(always)]
 pub fn sub(a: P3, b: P3) -> P3 {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
+/// The sum `a + b`.
 #[inline(always)]
 pub fn add(a: P3, b: P3) -> P3 {
     [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
 }
+/// `a` multiplied by the scalar `s`.
 #[inline(always)]
 pub fn scale(a: P3, s: f64) -> P3 {
     [a[0] * s, a[1] * s, a[2] * s]
 }
+/// The dot product of `a` and `b`.
 #[inline(always)]
 pub fn dot(a: P3, b: P3) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
+/// The cross product `a x b` (right-hand rule).
 #[inline(always)]
 pub fn cross(a: P3, b: P3) -> P3 {
     [
@@ -25,18 +30,22 @@ pub fn cross(a: P3, b: P3) -> P3 {
         a[0] * b[1] - a[1] * b[0],
     ]
 }
+/// The squared length of `a`, without the square root.
 #[inline(always)]
 pub fn norm2(a: P3) -> f64 {
     dot(a, a)
 }
+/// The Euclidean length of `a`.
 #[inline(always)]
 pub fn norm(a: P3) -> f64 {
     dot(a, a).sqrt()
 }
+/// The squared distance between `a` and `b`, without the square root.
 #[inline(always)]
 pub fn dist2(a: P3, b: P3) -> f64 {
     norm2(sub(a, b))
 }
+/// The Euclidean distance between `a` and `b`.
 #[inline(always)]
 pub fn dist(a: P3, b: P3) -> f64 {
     norm(sub(a, b))
@@ -56,6 +65,7 @@ pub fn normalize(a: P3) -> P3 {
 pub fn tri_normal(a: P3, b: P3, c: P3) -> P3 {
     cross(sub(b, a), sub(c, a))
 }
+/// The centroid of triangle `abc`.
 #[inline(always)]
 pub fn centroid3(a: P3, b: P3, c: P3) -> P3 {
     [

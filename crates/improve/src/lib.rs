@@ -25,6 +25,7 @@
 //! Everything is serial and in index order, so the result is determined
 //! by the input.
 #![forbid(unsafe_code)]
+#![warn(missing_docs)]
 
 mod insert;
 mod ops;
@@ -92,26 +93,41 @@ pub struct OpStats {
     pub tried: usize,
     /// Changes kept.
     pub done: usize,
+    /// Time spent in this operation's passes, in seconds; with parallel parts
+    /// (§9.5) the parts' times are summed, so it can exceed the wall time.
     pub seconds: f64,
 }
 
 /// What an improvement run did, per operation.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct ImproveStats {
+    /// Diagonal swapping (§9.1): 2-3 face swaps and edge removals.
     pub swap: OpStats,
+    /// Removal of bad tets by edge collapse (§9.2).
     pub collapse: OpStats,
+    /// Laplacian smoothing with move rejection (§9.3).
     pub smooth: OpStats,
+    /// Selective point movement (§9.4), and the later point moves that work
+    /// on the dihedral angles.
     pub selective: OpStats,
     /// Steiner point insertion around tets under 10° (an addition to §9).
     pub insert: OpStats,
     /// 2-3 swaps, 3-2 swaps, edge removals with n >= 4 among `swap.done`.
     pub swaps_23: usize,
+    /// 3-2 swaps (edge removal on a ring of three tets) among `swap.done`.
     pub swaps_32: usize,
+    /// Edge removals on rings of four or more tets (n -> 2n-4) among
+    /// `swap.done`.
     pub edge_removals: usize,
+    /// Points removed by edge collapse (§9.2), counted when the mesh is compacted.
     pub points_removed: usize,
+    /// Steiner points inserted (an addition to §9).
     pub points_inserted: usize,
+    /// Tets in the mesh on entry.
     pub tets_before: usize,
+    /// Tets in the mesh on return, after dead tets are dropped.
     pub tets_after: usize,
+    /// Wall time of the whole improvement, in seconds.
     pub seconds: f64,
 }
 

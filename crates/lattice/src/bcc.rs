@@ -13,8 +13,12 @@ use rustc_hash::{FxHashMap, FxHashSet};
 /// meshes: a front face's convention).
 #[derive(Clone, Debug, Default)]
 pub struct Lattice {
+    /// The filled cubes' corners (shared by the cells that meet there) and centres.
     pub points: Vec<P3>,
+    /// The tets, positively oriented (indices into `points`).
     pub tets: Vec<[u32; 4]>,
+    /// The outer faces (indices into `points`), normals pointing into the region
+    /// the front meshes; they join the surface in the initial front.
     pub faces: Vec<[u32; 3]>,
     /// Whether a point is on no outer face (the front never sees it).
     pub interior: Vec<bool>,
@@ -23,24 +27,31 @@ pub struct Lattice {
     pub size: Vec<f64>,
     /// Cubes filled, and their total volume.
     pub cells: usize,
+    /// The filled cubes' total volume (the sum of their edges cubed), against
+    /// which `check` measures the tets'.
     pub volume: f64,
 }
 
 /// Why a lattice is not valid.
 #[derive(Debug, Clone, PartialEq)]
 pub enum LatticeCheckError {
+    /// Tet `i` is not positively oriented (exactly).
     NotPositive(usize),
     /// A face used more than twice, or twice from the same side.
     Face([u32; 3]),
     /// The faces used once are not the outer faces.
     Boundary,
+    /// The tets' total volume is not the cubes' (to a relative 1e-9).
     Volume {
+        /// The sum of the tets' volumes.
         tets: f64,
+        /// The cubes' total volume ([`Lattice::volume`]).
         cells: f64,
     },
 }
 
 impl Lattice {
+    /// Whether the lattice has no tets (no cell qualified).
     pub fn is_empty(&self) -> bool {
         self.tets.is_empty()
     }

@@ -16,6 +16,7 @@
 //! block at an edge or a corner only are dropped, so each block's boundary
 //! is a manifold surface.
 #![forbid(unsafe_code)]
+#![warn(missing_docs)]
 mod bcc;
 mod inside;
 mod octree;

@@ -62,10 +62,13 @@ pub struct HealReport {
     pub tris_duplicate: usize,
     /// Shells whose orientation was made consistent, and triangles turned.
     pub shells_flipped: usize,
+    /// Triangles turned in those shells.
     pub tris_flipped: usize,
     /// Largest distance a vertex moved, absolute and over the shortest
     /// edge at it.
     pub max_distance: f64,
+    /// The largest ratio of a merge's distance to the shortest edge at its
+    /// vertices (the largest ratio, not the ratio of the largest move).
     pub max_relative: f64,
 }
 
@@ -74,6 +77,7 @@ impl HealReport {
     pub fn changed(&self) -> bool {
         self.vertices_merged > 0
     }
+    /// Triangles dropped in all: degenerate and duplicate.
     pub fn tris_dropped(&self) -> usize {
         self.tris_degenerate + self.tris_duplicate
     }
@@ -103,7 +107,9 @@ impl fmt::Display for HealReport {
 /// A healed surface, its report, and where each input point went.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Healed {
+    /// The healed surface, renumbered.
     pub surface: Surface,
+    /// What the healing changed.
     pub report: HealReport,
     /// Input point id -> output point id.
     pub point_map: Vec<u32>,

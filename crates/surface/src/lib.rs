@@ -7,6 +7,7 @@
 //! - [`heal`]: merges the vertices a float rounding split apart, where
 //!   that closes open edges (opt-in; exact welding stays the default).
 #![forbid(unsafe_code)]
+#![warn(missing_docs)]
 
 pub mod generate;
 pub mod hard;
@@ -23,7 +24,10 @@ use parafront_geom::P3;
 /// into the void.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Surface {
+    /// The vertices.
     pub points: Vec<P3>,
+    /// The triangles, as indices into `points`, normals pointing out of the
+    /// domain (see above).
     pub tris: Vec<[u32; 3]>,
     /// Patch tag per triangle (STL solid index, OBJ group, Gmsh entity or
     /// physical tag, Medit ref). 0 when the file has none.
@@ -45,6 +49,7 @@ impl Surface {
         }
     }
 
+    /// The bounding box of every point, used or not.
     pub fn bbox(&self) -> parafront_geom::Aabb {
         parafront_geom::Aabb::from_points(&self.points)
     }

@@ -139,6 +139,8 @@ impl Default for FrontOptions {
 
 /// A closed front to fill.
 pub struct FrontInput {
+    /// The points the faces index; they keep their ids in the result, and
+    /// the new points follow them.
     pub points: Vec<P3>,
     /// Size at each point (AG3).
     pub point_size: Vec<f64>,
@@ -146,17 +148,26 @@ pub struct FrontInput {
     pub faces: Vec<[u32; 3]>,
 }
 
+/// What the front did (AF1 to AF5), for reports.
 #[derive(Clone, Debug, Default)]
 pub struct FrontStats {
+    /// Tets in the result.
     pub tets: usize,
+    /// Points in the result beyond the input: the new points (AF2.1) and
+    /// the fill's Steiner points.
     pub new_points: usize,
+    /// Faces that failed to get a tet and went back to the queue or to the
+    /// stuck list (AF5).
     pub retries: usize,
+    /// Recovery rounds run (AF5: removal around the stuck faces and re-meshing).
     pub recovery_rounds: u32,
+    /// Tets removed again, by recovery and by growing the fill's cavities.
     pub tets_removed: usize,
     /// Pockets closed by coning to an inner point (recovery's last resort).
     pub pockets_filled: usize,
     /// Cavities closed by the constrained Delaunay fill, and its tets.
     pub cavities_filled: usize,
+    /// Tets the constrained Delaunay fill made.
     pub fill_tets: usize,
 }
 
@@ -165,6 +176,8 @@ pub struct FrontStats {
 pub struct FrontResult {
     /// Input points first, in input order, then the new points.
     pub points: Vec<P3>,
+    /// Size (target edge length) at each point of `points`: the input's, then
+    /// each new point's (AF4).
     pub point_size: Vec<f64>,
     /// Positively oriented tets.
     pub tets: Vec<[u32; 4]>,
@@ -173,6 +186,7 @@ pub struct FrontResult {
     /// Faces the region filter kept from being advanced, and in pass mode
     /// the faces that got stuck (pass hand-over).
     pub front: Vec<[u32; 3]>,
+    /// What the front did.
     pub stats: FrontStats,
 }
 
@@ -180,19 +194,29 @@ pub struct FrontResult {
 /// faces still in the front, in one numbering.
 #[derive(Debug, Default)]
 pub struct Partial {
+    /// Every point so far: the input's first, in input order, then the new ones.
     pub points: Vec<P3>,
+    /// The live tets, positively oriented.
     pub tets: Vec<[u32; 4]>,
+    /// The faces still in the front, normals pointing into the unmeshed region.
     pub front: Vec<[u32; 3]>,
 }
 
+/// Why the front did not finish.
 #[derive(Debug, thiserror::Error)]
 pub enum FrontError {
+    /// Recovery (AF5) and the fill could not close the front.
     #[error("the front could not be closed after {rounds} recovery rounds: {faces} faces stuck near ({x:.6e}, {y:.6e}, {z:.6e})")]
     Stuck {
+        /// Recovery rounds run.
         rounds: u32,
+        /// Faces stuck at the end.
         faces: usize,
+        /// x of the first stuck face's centroid.
         x: f64,
+        /// y of the first stuck face's centroid.
         y: f64,
+        /// z of the first stuck face's centroid.
         z: f64,
         /// With `FrontOptions::keep_partial`.
         partial: Option<Box<Partial>>,
@@ -200,7 +224,19 @@ pub enum FrontError {
     #[error(
         "the front is not closed: edge ({a}, {b}) is used by {count} faces with this direction"
     )]
-    OpenFront { a: u32, b: u32, count: usize },
+    /// The input front is not closed (checked outside pass mode): directed
+    /// edge `a`-`b` is used by `count` faces and its reverse by a different
+    /// number.
+    OpenFront {
+        /// The edge's first point.
+        a: u32,
+        /// The edge's second point.
+        b: u32,
+        /// Faces that use the edge from `a` to `b`.
+        count: usize,
+    },
+    /// More points than `FrontOptions::max_points` (the limit given): a size
+    /// field or a front running away.
     #[error("more than {0} points: the size field or the front is running away")]
     TooManyPoints(usize),
 }

@@ -30,7 +30,10 @@ use std::path::Path;
 pub enum Format {
     /// STL, ascii or binary (told apart by content).
     Stl,
+    /// Wavefront OBJ (`v` and `f`; polygons fan-triangulated, `g`/`o` groups as
+    /// patches).
     Obj,
+    /// OFF and its variants (COFF, NOFF, ...); polygons fan-triangulated.
     Off,
     /// Gmsh .msh 2.2 or 4.1, ascii or binary (told apart by `$MeshFormat`).
     Msh,
@@ -77,17 +80,31 @@ impl fmt::Display for Loc {
 /// A file that could not be read as a surface.
 #[derive(Debug, thiserror::Error)]
 pub enum ReadError {
+    /// The file could not be read.
     #[error("{file}: {source}")]
     Io {
+        /// The file's name, as given to the reader.
         file: String,
+        /// The I/O error.
         #[source]
         source: std::io::Error,
     },
+    /// The file's extension names no supported format.
     #[error("{file}: unknown file extension (expected .stl, .obj, .off, .msh or .mesh)")]
-    UnknownFormat { file: String },
+    UnknownFormat {
+        /// The file's name, as given to the reader.
+        file: String,
+    },
     /// Malformed content: `what` says what is wrong at `at`.
     #[error("{file}{at}: {what}")]
-    Bad { file: String, at: Loc, what: String },
+    Bad {
+        /// The file's name, as given to the reader.
+        file: String,
+        /// Where in the file.
+        at: Loc,
+        /// What is wrong there.
+        what: String,
+    },
 }
 
 impl ReadError {
@@ -140,10 +157,15 @@ pub fn read_surface_bytes(name: &str, bytes: &[u8], fmt: Format) -> Result<Surfa
 /// Medit reference.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct VolumeData {
+    /// The nodes, in file order.
     pub points: Vec<P3>,
+    /// The triangles, in file order.
     pub tris: Vec<[u32; 3]>,
+    /// The tag of each triangle.
     pub tri_tags: Vec<u32>,
+    /// The tetrahedra, in file order.
     pub tets: Vec<[u32; 4]>,
+    /// The tag of each tet.
     pub tet_tags: Vec<u32>,
     /// Names of 2-D physical groups (surface patches).
     pub names: Vec<(u32, String)>,

@@ -57,6 +57,7 @@ impl Class {
     pub fn is_error(self) -> bool {
         self != Class::UnreferencedVertex
     }
+    /// A plain-words description of the class, for reports.
     pub fn describe(self) -> &'static str {
         match self {
             Class::NoTriangles => "no triangles (the file has points only, or nothing)",
@@ -84,36 +85,67 @@ impl Class {
 pub enum Item {
     /// An edge `v[0]-v[1]` and (up to 6 of) the triangles using it.
     Edge {
+        /// The edge's vertex ids.
         v: [u32; 2],
+        /// The two vertices' coordinates.
         p: [P3; 2],
+        /// Triangles using the edge, up to 6.
         tris: Vec<u32>,
     },
     /// A vertex; `fans` is the number of triangle fans around it (0 when unused).
-    Vertex { v: u32, p: P3, fans: u32 },
+    Vertex {
+        /// The vertex id.
+        v: u32,
+        /// Its coordinates.
+        p: P3,
+        /// Triangle fans around it.
+        fans: u32,
+    },
     /// A triangle.
-    Tri { t: u32, v: [u32; 3], p: [P3; 3] },
+    Tri {
+        /// The triangle id.
+        t: u32,
+        /// Its vertex ids.
+        v: [u32; 3],
+        /// Its corners' coordinates.
+        p: [P3; 3],
+    },
     /// Two triangles: (earlier, later) for duplicates, the pair for
     /// intersections.
     TriPair {
+        /// The two triangle ids.
         t: [u32; 2],
+        /// Their vertex ids.
         v: [[u32; 3]; 2],
+        /// Their corners' coordinates.
         p: [[P3; 3]; 2],
     },
     /// A shell, its first triangle and signed volume.
     Shell {
+        /// The shell's index in [`Report::shells`].
         shell: u32,
+        /// Its lowest triangle id.
         first_tri: u32,
+        /// Its signed enclosed volume (positive when the normals point outward).
         volume: f64,
+        /// The number of closed shells containing it.
         depth: u32,
     },
     /// A triangle whose vertex id is out of range.
-    BadTri { t: u32, v: [u32; 3] },
+    BadTri {
+        /// The triangle id.
+        t: u32,
+        /// Its vertex ids, one at least out of range.
+        v: [u32; 3],
+    },
 }
 
 /// All defects of one class.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Problem {
+    /// The defect class.
     pub class: Class,
+    /// How many offenders there are, all of them (not only the examples).
     pub count: usize,
     /// The first `MAX_EXAMPLES` offenders, in id order.
     pub examples: Vec<Item>,
@@ -122,7 +154,9 @@ pub struct Problem {
 /// The result of [`validate`].
 #[derive(Clone, Debug, PartialEq)]
 pub struct Report {
+    /// Points in the surface.
     pub n_points: usize,
+    /// Triangles in the surface.
     pub n_tris: usize,
     /// Non-empty classes only, in `Class` order.
     pub problems: Vec<Problem>,
@@ -136,6 +170,7 @@ impl Report {
     pub fn is_valid(&self) -> bool {
         self.problems.iter().all(|p| !p.class.is_error())
     }
+    /// The defects of `class`, if any were found.
     pub fn problem(&self, class: Class) -> Option<&Problem> {
         self.problems.iter().find(|p| p.class == class)
     }

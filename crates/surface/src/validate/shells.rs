@@ -15,6 +15,7 @@ use parafront_geom::intersect::segment_triangle_parity;
 use parafront_geom::{Aabb, P3};
 use rayon::prelude::*;
 
+/// What a shell is, from its nesting depth and the sign of its volume.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum ShellKind {
     /// Depth 0: bounds the domain from outside; must have positive volume.
@@ -28,6 +29,7 @@ pub enum ShellKind {
 }
 
 impl ShellKind {
+    /// A plain-words name of the kind, for reports.
     pub fn describe(self) -> &'static str {
         match self {
             ShellKind::Outer => "outer shell",
@@ -38,6 +40,8 @@ impl ShellKind {
     }
 }
 
+/// An edge-connected component of a surface's triangles, and how it nests
+/// among the closed shells.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Shell {
     /// Triangle ids, ascending.
@@ -48,6 +52,7 @@ pub struct Shell {
     pub depth: u32,
     /// The innermost shell containing this one.
     pub parent: Option<u32>,
+    /// What the shell is: outer shell, void, inner body, or not closed.
     pub kind: ShellKind,
 }
 
@@ -66,7 +71,9 @@ impl Shell {
 /// body) and outside each of its `voids`.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Region {
+    /// The shell that bounds the region from outside (an index into the shells).
     pub outer: u32,
+    /// The voids directly inside `outer` (their parent), as shell indices.
     pub voids: Vec<u32>,
 }
 
