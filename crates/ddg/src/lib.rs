@@ -11,7 +11,6 @@ mod field;
 mod locate;
 mod partition;
 
-pub use check::DdgCheckError;
 pub use field::GradedField;
 
 pub use locate::{Interfaces, Locator, PartFilter};

@@ -5,7 +5,8 @@
 //! the lattice's outer faces.
 use crate::octree::Cells;
 use crate::CUBE_PER_SIZE;
-use parafront_geom::{orient3d, tet_volume6, P3};
+use parafront_geom::{tet_volume6, P3};
+use parafront_mesh::{CheckError, PointId, TetMesh, VOLUME_RTOL};
 use rustc_hash::{FxHashMap, FxHashSet};
 
 /// A lattice: points, positive tets, and the outer faces (right-hand
@@ -35,12 +36,11 @@ pub struct Lattice {
 /// Why a lattice is not valid.
 #[derive(Debug, Clone, PartialEq)]
 pub enum LatticeCheckError {
-    /// Tet `i` is not positively oriented (exactly).
-    NotPositive(usize),
-    /// A face used more than twice, or twice from the same side.
-    Face([u32; 3]),
-    /// The faces used once are not the outer faces.
-    Boundary,
+    /// As a mesh bounded by its outer faces it fails `TetMesh`'s check: a
+    /// tet not positive (exactly), a face in more than two tets or twice
+    /// from one side, the faces used once not exactly the outer faces
+    /// (oriented away from their tet), or the volumes not adding up.
+    Mesh(CheckError),
     /// The tets' total volume is not the cubes' (to a relative 1e-9).
     Volume {
         /// The sum of the tets' volumes.
@@ -56,63 +56,25 @@ impl Lattice {
         self.tets.is_empty()
     }
 
-    /// Every tet positive (exactly), every face shared by at most two tets
-    /// from opposite sides, the faces used once exactly the outer faces
-    /// (oriented away from their tet), and the tets' volume the cubes'.
+    /// `TetMesh::check_against_surface` with the outer faces as the
+    /// surface, and the tets' volume the cubes'.
     pub fn check(&self) -> Result<(), LatticeCheckError> {
-        let mut vol = 0.0;
-        let mut once: FxHashMap<[u32; 3], [u32; 3]> = FxHashMap::default();
-        let mut twice: FxHashSet<[u32; 3]> = FxHashSet::default();
-        for (i, t) in self.tets.iter().enumerate() {
-            let p = t.map(|v| self.points[v as usize]);
-            if !(orient3d(p[0], p[1], p[2], p[3]) > 0.0) {
-                return Err(LatticeCheckError::NotPositive(i));
-            }
-            vol += tet_volume6(p[0], p[1], p[2], p[3]) / 6.0;
-            // Each face, its normal pointing out of the tet.
-            for f in [
-                [t[1], t[2], t[3]],
-                [t[0], t[3], t[2]],
-                [t[0], t[1], t[3]],
-                [t[0], t[2], t[1]],
-            ] {
-                let mut k = f;
-                k.sort_unstable();
-                if twice.contains(&k) {
-                    return Err(LatticeCheckError::Face(k));
-                }
-                match once.remove(&k) {
-                    Some(g) if same_cycle(g, [f[0], f[2], f[1]]) => {
-                        twice.insert(k);
-                    }
-                    Some(_) => return Err(LatticeCheckError::Face(k)),
-                    None => {
-                        once.insert(k, f);
-                    }
-                }
-            }
-        }
-        if once.len() != self.faces.len()
-            || !self.faces.iter().all(|&f| {
-                let mut k = f;
-                k.sort_unstable();
-                once.get(&k).is_some_and(|&g| same_cycle(g, f))
-            })
-        {
-            return Err(LatticeCheckError::Boundary);
-        }
-        if (vol - self.volume).abs() > 1e-9 * self.volume.max(f64::MIN_POSITIVE) {
+        let mesh = TetMesh {
+            points: self.points.clone(),
+            tets: self.tets.iter().map(|t| t.map(PointId::from_raw)).collect(),
+            ..TetMesh::default()
+        };
+        let st = mesh
+            .check_against_surface(&self.faces)
+            .map_err(LatticeCheckError::Mesh)?;
+        if (st.volume - self.volume).abs() > VOLUME_RTOL * self.volume.max(f64::MIN_POSITIVE) {
             return Err(LatticeCheckError::Volume {
-                tets: vol,
+                tets: st.volume,
                 cells: self.volume,
             });
         }
         Ok(())
     }
-}
-
-fn same_cycle(a: [u32; 3], b: [u32; 3]) -> bool {
-    a == b || a == [b[1], b[2], b[0]] || a == [b[2], b[0], b[1]]
 }
 
 /// The square of cell `ijk`'s face on axis `a`, side `hi` (0 or 1): its

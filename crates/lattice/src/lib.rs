@@ -140,6 +140,19 @@ mod tests {
             let q = parafront_geom::tet_volume6(p[0], p[1], p[2], p[3]);
             assert!(q > 0.0);
         }
+        // The check names what is broken.
+        let mut bad = l.clone();
+        bad.tets[0].swap(0, 1);
+        assert!(matches!(bad.check(), Err(LatticeCheckError::Mesh(_))));
+        let mut bad = l.clone();
+        bad.tets.pop();
+        assert!(matches!(bad.check(), Err(LatticeCheckError::Mesh(_))));
+        let mut bad = l.clone();
+        bad.faces.pop();
+        assert!(matches!(bad.check(), Err(LatticeCheckError::Mesh(_))));
+        let mut bad = l.clone();
+        bad.volume *= 1.001;
+        assert!(matches!(bad.check(), Err(LatticeCheckError::Volume { .. })));
     }
 
     #[test]

@@ -394,7 +394,7 @@ enum PartCheckError {
 }
 
 /// [`Part::check`] on every part, in debug builds.
-fn debug_check_parts(parts: &[Part], after: &str) {
+fn debug_check_parts(parts: &[Part], after: impl std::fmt::Display) {
     if cfg!(debug_assertions) {
         for (k, p) in parts.iter().enumerate() {
             if let Err(e) = p.check() {

@@ -145,7 +145,7 @@ impl<C: Comm> Passes<'_, C> {
                 self.shift(step, parts, on, rec);
             }
             self.pass(step, parts, on.of(step), next_gid, rec)?;
-            crate::debug_check_parts(parts, &format!("pass {step}"));
+            crate::debug_check_parts(parts, format_args!("pass {step}"));
         }
         Ok(())
     }
