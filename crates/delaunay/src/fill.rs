@@ -1,9 +1,12 @@
 //! The constrained fill of a closed cavity, in order: the
 //! Delaunay tetrahedralization of its points with its faces recovered by
 //! flips and the tets outside removed; the cone from its kernel's deepest
-//! point (a star-shaped cavity); the search (`search.rs`); Steiner points
-//! strictly inside it in the triangulation, under other perturbations.
+//! point (a star-shaped cavity); the search (`search.rs`); the conforming
+//! fill (`conform.rs`: edges split, split points moved inside); Steiner
+//! points strictly inside it in the triangulation, under other
+//! perturbations.
 //! Every result is verified exactly.
+use crate::conform::conform_fill;
 use crate::flips::{key3, same_cycle};
 use crate::recover::{crossings, recover_all};
 use crate::search::search_fill;
@@ -30,6 +33,9 @@ pub struct FillOptions {
     pub search_nodes: usize,
     /// Cavities with more faces are not searched.
     pub max_search_faces: usize,
+    /// Points the conforming fill may put on the cavity's edges (each
+    /// moved into the cavity at the end); 0 turns it off.
+    pub max_split: usize,
 }
 
 impl Default for FillOptions {
@@ -41,6 +47,7 @@ impl Default for FillOptions {
             max_steiner_faces: 200,
             search_nodes: 4000,
             max_search_faces: 400,
+            max_split: 4096,
         }
     }
 }
@@ -56,6 +63,9 @@ pub enum FillMethod {
     /// Tets found by a search over the cavity's points (and Steiner
     /// points), each verified in the cavity.
     Search,
+    /// Constrained Delaunay with the cavity's edges split where flips
+    /// stall, each split point then moved into the cavity.
+    Conform,
 }
 
 /// A cavity's fill.
@@ -146,6 +156,11 @@ pub fn fill_cavity(
                 flips,
             });
         }
+    }
+    // Then split the edges flips cannot recover, and move the split
+    // points into the cavity.
+    if let Some(f) = conform(points, faces, &local, opts) {
+        return Ok(f);
     }
     // Last, Steiner points in the triangulation, under other symbolic
     // perturbations (on CAD's coplanar and cospherical points they pick
@@ -276,7 +291,7 @@ fn validate(points: &[P3], faces: &[[u32; 3]]) -> Result<(), FillError> {
 /// The tets inside the recovered faces, grown from each face's inner side
 /// without crossing a face; `None` unless they are bounded by exactly the
 /// faces, each once and from its inner side, and hold no bounding corner.
-fn classify(tri: &Triangulation, cf: &[[u32; 3]]) -> Option<Vec<u32>> {
+pub(crate) fn classify(tri: &Triangulation, cf: &[[u32; 3]]) -> Option<Vec<u32>> {
     let oriented: FxHashMap<[u32; 3], [u32; 3]> = cf.iter().map(|&f| (key3(f), f)).collect();
     let mut inside = vec![false; tri.tet_slots()];
     let mut queue = Vec::new();
@@ -378,6 +393,46 @@ fn output(
         method,
         flips,
     }
+}
+
+/// The conforming fill ([`conform_fill`]) over the points `local`.
+fn conform(points: &[P3], faces: &[[u32; 3]], local: &[u32], opts: &FillOptions) -> Option<Fill> {
+    // Large cavities are grown by the caller instead: a failing
+    // conforming fill of the tray's 1,426-face slab took 7 s.
+    if opts.max_split == 0 || faces.len() > opts.max_steiner_faces {
+        return None;
+    }
+    let lp: Vec<P3> = local.iter().map(|&i| points[i as usize]).collect();
+    let to_local: FxHashMap<u32, u32> = local
+        .iter()
+        .enumerate()
+        .map(|(k, &i)| (i, k as u32))
+        .collect();
+    let lf: Vec<[u32; 3]> = faces.iter().map(|f| f.map(|v| to_local[&v])).collect();
+    // A point per face and a few more: the fills that converge on the
+    // corpus use fewer (the tray's 158-face slab: 27).
+    let max_split = opts.max_split.min(16 + faces.len());
+    let (steiner, tets) = conform_fill(&lp, &lf, max_split, opts.flips_per_face)?;
+    let nl = local.len() as u32;
+    let n = points.len() as u32;
+    let tets = tets
+        .iter()
+        .map(|t| {
+            t.map(|v| {
+                if v < nl {
+                    local[v as usize]
+                } else {
+                    n + v - nl
+                }
+            })
+        })
+        .collect();
+    Some(Fill {
+        steiner,
+        tets,
+        method: FillMethod::Conform,
+        flips: 0,
+    })
 }
 
 /// The cone from the kernel's deepest point, verified exactly.

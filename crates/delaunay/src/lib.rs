@@ -15,11 +15,14 @@
 //! missing faces by flips, and keeps the tets inside. Where flips stall it
 //! tries the cone from the kernel's deepest point, then a search (a front
 //! with exact validity and no quality rules that can step back, adding
-//! Steiner points strictly inside the cavity at its dead ends), then Steiner
-//! points in the triangulation.
+//! Steiner points strictly inside the cavity at its dead ends), then the
+//! conforming fill (the missing edges split in the triangulation, the
+//! split points then moved off the surface into the cavity, after Si and
+//! Gärtner), then Steiner points in the triangulation.
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 mod check;
+mod conform;
 mod fill;
 mod flips;
 mod predicates;

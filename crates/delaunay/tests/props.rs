@@ -351,17 +351,16 @@ proptest! {
     }
 }
 
-/// A known failure of the fill, found by `fills_twisted_towers`: a squat
-/// tower of three layers (height 0.01 a layer, width 2). Flips leave 11 of
-/// its 20 faces missing, every one with a missing edge, and the search runs
-/// out of Steiner points that give its last dead end an apex. It needs
-/// edge recovery (Steiner points on the missing edges, then moved off the
-/// surface); `cargo test -- --ignored` runs it.
+/// Found by `fills_twisted_towers`: a squat tower of three layers (height
+/// 0.01 a layer, width 2). Flips leave 11 of its 20 faces missing, every
+/// one with a missing edge, and the search runs out of Steiner points; the
+/// conforming fill splits the missing edges and moves the split points
+/// into the cavity.
 #[test]
-#[ignore = "known failure: the fill cannot close this squat three-layer tower yet"]
 fn fills_a_squat_three_layer_tower() {
     let twists = [0.42912146221657504, 0.4137627233452473, 0.7758174272098246];
     let (pts, faces) = twisted_tower(&twists, 0.01);
     let f = fill_cavity(&pts, &faces, &FillOptions::default()).expect("fill");
     verify(&pts, &faces, &f);
+    assert_eq!(f.method, FillMethod::Conform);
 }
