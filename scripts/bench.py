@@ -57,8 +57,8 @@ SETS = {
     ],
     # Issue 20's hard surfaces, written by the CLI's hard_surfaces example.
     "hard": [(f"%{n}.obj", []) for n in ["needle_1000", "needle_5000", "schonhardt",
-                                          "twisted_square", "rod", "slot_1e-2", "slot_1e-3",
-                                          "boss_1e-4"]]
+                                          "twisted_square", "squat_tower", "rod", "slot_1e-2",
+                                          "slot_1e-3", "boss_1e-4"]]
     + [("%slot_1e-2.obj", ["--size", "0.1"]), ("%boss_1e-4.obj", ["--size", "0.1"])],
     "bench1e5": [(f"bench/{n}_1e5.stl", []) for n in ["sphere", "torus", "box2holes", "spheres27"]],
     "bench1e6": [(f"bench/{n}_1e6.stl", []) for n in ["sphere", "torus"]],
@@ -74,7 +74,7 @@ SETS = {
 def resolve(rel, work):
     if rel.startswith("%"):
         hard = os.path.join(work, "hard")
-        if not os.path.isdir(hard):
+        if not os.path.exists(os.path.join(hard, rel[1:])):
             subprocess.run(["cargo", "run", "--release", "-q", "-p", "parafront", "--example",
                             "hard_surfaces", "--", hard], cwd=ROOT, check=True,
                            stdout=subprocess.DEVNULL)

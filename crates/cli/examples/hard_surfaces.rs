@@ -2,8 +2,11 @@
 //! files, for `scripts/bench.py --sets hard` and for the peers:
 //! `cargo run --release -p parafront --example hard_surfaces -- OUTDIR`.
 use parafront_io::{write_surface, WriteOptions};
-use parafront_surface::hard::{boss_box, frustum, rod, slotted_box};
+use parafront_surface::hard::{boss_box, frustum, rod, slotted_box, twisted_tower};
 use std::path::Path;
+
+/// The squat tower's twists (found by the fill's property test).
+const SQUAT_TWISTS: [f64; 3] = [0.42912146221657504, 0.4137627233452473, 0.7758174272098246];
 
 fn main() {
     let Some(dir) = std::env::args().nth(1) else {
@@ -22,6 +25,9 @@ fn main() {
         // Twisted prisms: no tetrahedralization of their own corners.
         ("schonhardt", frustum(3, 1.0, 1.0, 1.0, 0.5)),
         ("twisted_square", frustum(4, 1.0, 1.0, 1.0, 0.6)),
+        // Three twisted layers 0.01 high on a radius of 1: flips leave
+        // most faces missing, and only the conforming fill closes it.
+        ("squat_tower", twisted_tower(&SQUAT_TWISTS, 0.01)),
         // A rod of aspect 1,000 with side triangles of aspect 3,000.
         ("rod", rod(8, 0.02, 20.0, 4)),
         // Slots 1 % and 0.1 % of the part.

@@ -310,29 +310,8 @@ fn fills_the_round_stl_cavity() {
 /// tetrahedralization of its own points, and a tall tower is not
 /// star-shaped. Faces inward.
 fn twisted_tower(twists: &[f64], height: f64) -> (Vec<P3>, Vec<[u32; 3]>) {
-    let mut pts = Vec::new();
-    let mut angle = 0.0;
-    for l in 0..=twists.len() {
-        if l > 0 {
-            angle += twists[l - 1];
-        }
-        for k in 0..3 {
-            let a = k as f64 * 2.0943951023931953 + angle;
-            pts.push([a.cos(), a.sin(), l as f64 * height]);
-        }
-    }
-    let top = 3 * twists.len() as u32;
-    let mut out = vec![[0, 2, 1], [top, top + 1, top + 2]];
-    for l in 0..twists.len() as u32 {
-        for k in 0..3u32 {
-            let (a, b) = (3 * l + k, 3 * l + (k + 1) % 3);
-            let (c, d) = (a + 3, b + 3);
-            out.push([a, b, d]);
-            out.push([a, d, c]);
-        }
-    }
-    let inward = out.iter().map(|f| [f[0], f[2], f[1]]).collect();
-    (pts, inward)
+    let s = parafront_surface::hard::twisted_tower(twists, height).flipped();
+    (s.points, s.tris)
 }
 
 proptest! {

@@ -3,8 +3,9 @@
 //! options and with a size far above its smallest edge, keep its surface
 //! and fill it exactly.
 use parafront_pipeline::{mesh_surface, MeshOptions};
-use parafront_surface::hard::{boss_box, frustum, rod, slotted_box};
+use parafront_surface::hard::{boss_box, frustum, rod, slotted_box, twisted_tower};
 use parafront_surface::Surface;
+use proptest::prelude::*;
 
 fn smallest_edge(s: &Surface) -> f64 {
     let d = |a: u32, b: u32| {
@@ -127,4 +128,17 @@ fn tiny_feature_beside_large_faces() {
 #[test]
 fn tiny_feature_under_a_given_size() {
     meshes_at("boss 1e-4", &boss_box(1e-4), &[Some(0.5), Some(0.1)]);
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(12))]
+    /// Towers of twisted layers (no layer has a tetrahedralization of its
+    /// own corners), squat or tall: each meshes with default options.
+    #[test]
+    fn twisted_towers(
+        twists in prop::collection::vec(0.2f64..0.9, 1..5),
+        height in prop::sample::select(vec![0.01, 0.3, 5.0]),
+    ) {
+        meshes_at("tower", &twisted_tower(&twists, height), &[None]);
+    }
 }

@@ -117,6 +117,35 @@ pub fn rod(k: usize, r: f64, len: f64, segs: usize) -> Surface {
     surface(p, t)
 }
 
+/// A tower of twisted triangular layers (Schönhardt's prism stacked):
+/// layer `l` of height `height` turns by `twists[l]` radians, its sides
+/// split along the diagonal that makes it untetrahedralizable without a
+/// Steiner point; radius 1.
+pub fn twisted_tower(twists: &[f64], height: f64) -> Surface {
+    let mut p = Vec::new();
+    let mut angle = 0.0;
+    for l in 0..=twists.len() {
+        if l > 0 {
+            angle += twists[l - 1];
+        }
+        for k in 0..3 {
+            let a = k as f64 * std::f64::consts::TAU / 3.0 + angle;
+            p.push([a.cos(), a.sin(), l as f64 * height]);
+        }
+    }
+    let top = 3 * twists.len() as u32;
+    let mut t = vec![[0, 2, 1], [top, top + 1, top + 2]];
+    for l in 0..twists.len() as u32 {
+        for k in 0..3u32 {
+            let (a, b) = (3 * l + k, 3 * l + (k + 1) % 3);
+            let (c, d) = (a + 3, b + 3);
+            t.push([a, b, d]);
+            t.push([a, d, c]);
+        }
+    }
+    surface(p, t)
+}
+
 /// The unit box with a cubic boss `e` wide and high at the centre of its
 /// top face (a feature `e` of the part beside faces of 1).
 pub fn boss_box(e: f64) -> Surface {
