@@ -25,8 +25,10 @@ fn main() {
         // Twisted prisms: no tetrahedralization of their own corners.
         ("schonhardt", frustum(3, 1.0, 1.0, 1.0, 0.5)),
         ("twisted_square", frustum(4, 1.0, 1.0, 1.0, 0.6)),
-        // Three twisted layers 0.01 high on a radius of 1: flips leave
-        // most faces missing, and only the conforming fill closes it.
+        // Three twisted layers 0.01 high on a radius of 1: as one cavity,
+        // flips leave 11 of its 20 faces missing and only the conforming
+        // fill closes it (the front makes a tet first, and the fill closes
+        // what is left).
         ("squat_tower", twisted_tower(&SQUAT_TWISTS, 0.01)),
         // A rod of aspect 1,000 with side triangles of aspect 3,000.
         ("rod", rod(8, 0.02, 20.0, 4)),

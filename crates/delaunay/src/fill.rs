@@ -153,7 +153,8 @@ pub fn fill_cavity(
         // search, so half the faces made the slot's failing fills 3 s
         // longer and closed no more.
         let steiner = opts.max_steiner + faces.len() / 8;
-        if let Some((steiner, tets)) = search_fill(points, faces, opts.search_nodes, steiner) {
+        let search = |lp: &[P3], lf: &[[u32; 3]]| search_fill(lp, lf, opts.search_nodes, steiner);
+        if let Some((steiner, tets)) = in_local_ids(points, faces, &local, search) {
             return Ok(Fill {
                 steiner,
                 tets,
@@ -409,6 +410,28 @@ fn conform(points: &[P3], faces: &[[u32; 3]], local: &[u32], opts: &FillOptions)
     if opts.max_split == 0 || faces.len() > opts.max_steiner_faces {
         return None;
     }
+    // A point per face and a few more: the fills that converge on the
+    // corpus use fewer (the tray's 158-face slab: 27).
+    let max_split = opts.max_split.min(16 + faces.len());
+    let fill = |lp: &[P3], lf: &[[u32; 3]]| conform_fill(lp, lf, max_split, opts.flips_per_face);
+    let (steiner, tets) = in_local_ids(points, faces, local, fill)?;
+    Some(Fill {
+        steiner,
+        tets,
+        method: FillMethod::Conform,
+        flips: 0,
+    })
+}
+
+/// Runs `fill` on the cavity in local ids (`local`, the cavity's corners,
+/// are ids `0..`) and maps its tets back: a local id past the corners is
+/// the caller's `points.len() + k`, for the `k`-th Steiner point returned.
+fn in_local_ids(
+    points: &[P3],
+    faces: &[[u32; 3]],
+    local: &[u32],
+    fill: impl FnOnce(&[P3], &[[u32; 3]]) -> Option<(Vec<P3>, Vec<[u32; 4]>)>,
+) -> Option<(Vec<P3>, Vec<[u32; 4]>)> {
     let lp: Vec<P3> = local.iter().map(|&i| points[i as usize]).collect();
     let to_local: FxHashMap<u32, u32> = local
         .iter()
@@ -416,10 +439,7 @@ fn conform(points: &[P3], faces: &[[u32; 3]], local: &[u32], opts: &FillOptions)
         .map(|(k, &i)| (i, k as u32))
         .collect();
     let lf: Vec<[u32; 3]> = faces.iter().map(|f| f.map(|v| to_local[&v])).collect();
-    // A point per face and a few more: the fills that converge on the
-    // corpus use fewer (the tray's 158-face slab: 27).
-    let max_split = opts.max_split.min(16 + faces.len());
-    let (steiner, tets) = conform_fill(&lp, &lf, max_split, opts.flips_per_face)?;
+    let (steiner, tets) = fill(&lp, &lf)?;
     let nl = local.len() as u32;
     let n = points.len() as u32;
     let tets = tets
@@ -434,12 +454,7 @@ fn conform(points: &[P3], faces: &[[u32; 3]], local: &[u32], opts: &FillOptions)
             })
         })
         .collect();
-    Some(Fill {
-        steiner,
-        tets,
-        method: FillMethod::Conform,
-        flips: 0,
-    })
+    Some((steiner, tets))
 }
 
 /// The cone from the kernel's deepest point, verified exactly.

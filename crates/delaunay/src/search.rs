@@ -38,28 +38,18 @@ struct Search {
 /// Candidate apexes of a face in a large cavity: the points nearest it.
 const NEAREST: usize = 40;
 
-/// Tile the cavity `faces` (of `pts`, normals inwards) with tets on its
-/// points and at most `max_steiner` points added strictly inside it, in at
-/// most `nodes` search steps between two Steiner points. The tets use ids
-/// of `pts`, then of the added points (returned).
+/// Tile the cavity `faces` (of `pts`, normals inwards; every point a
+/// corner) with tets on its points and at most `max_steiner` points added
+/// strictly inside it, in at most `nodes` search steps between two Steiner
+/// points. The tets use ids of `pts`, then of the added points (returned).
 pub(crate) fn search_fill(
     pts: &[P3],
     faces: &[[u32; 3]],
     nodes: usize,
     max_steiner: usize,
 ) -> Option<(Vec<P3>, Vec<[u32; 4]>)> {
-    // Local ids: the cavity's corners, then the Steiner points.
-    let mut glob: Vec<u32> = faces.iter().flatten().copied().collect();
-    glob.sort_unstable();
-    glob.dedup();
-    let local: rustc_hash::FxHashMap<u32, u32> = glob
-        .iter()
-        .enumerate()
-        .map(|(k, &g)| (g, k as u32))
-        .collect();
-    let lf: Vec<[u32; 3]> = faces.iter().map(|f| f.map(|v| local[&v])).collect();
-    let lp: Vec<P3> = glob.iter().map(|&g| pts[g as usize]).collect();
-    let mut s = Search::new(lp, &lf);
+    let n = pts.len();
+    let mut s = Search::new(pts.to_vec(), faces);
     let mut added = 0;
     loop {
         // Depth first from the last Steiner point; on failure, back to the
@@ -106,26 +96,11 @@ pub(crate) fn search_fill(
         s.add_point(q);
         added += 1;
     }
-    if !tiles(&lf, &s.tets) {
+    if !tiles(faces, &s.tets) {
         tracing::debug!("fill search: the tets do not tile the cavity");
         return None;
     }
-    let n = glob.len() as u32;
-    let steiner = s.pts[glob.len()..].to_vec();
-    let tets = s
-        .tets
-        .iter()
-        .map(|t| {
-            t.map(|v| {
-                if v < n {
-                    glob[v as usize]
-                } else {
-                    pts.len() as u32 + v - n
-                }
-            })
-        })
-        .collect();
-    Some((steiner, tets))
+    Some((s.pts[n..].to_vec(), s.tets))
 }
 
 /// Whether `tets` tile the cavity `faces`: each tet face is a cavity face
