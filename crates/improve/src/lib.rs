@@ -207,6 +207,10 @@ const DIHEDRAL_KEEP: f64 = 0.9;
 /// tan(`SMALL_DIHEDRAL`) (10°), for [`quality::has_dihedral_under`]; a
 /// test holds them together.
 const TAN_SMALL_DIHEDRAL: f64 = 0.176_326_980_708_464_98;
+/// tan(12.5°): the dihedral count's search takes a tet with no angle
+/// under it (the cheap tangent test) as adding nothing to its count or
+/// shortfall, which stop at 10° and 12°.
+const TAN_12_5: f64 = 0.221_694_662_642_939_88;
 /// Rounds of point insertion.
 const INSERT_ROUNDS: usize = 3;
 /// Rounds of insertion that lift the tets under 0.1°, after those.
@@ -431,5 +435,27 @@ mod tan_tests {
     fn tan_small_dihedral_is_tan_of_the_threshold() {
         let t = parafront_mesh::quality::SMALL_DIHEDRAL.to_radians().tan();
         assert!((t - super::TAN_SMALL_DIHEDRAL).abs() <= 1e-16, "{t}");
+        let t = 12.5f64.to_radians().tan();
+        assert!((t - super::TAN_12_5).abs() <= 1e-16, "{t}");
+    }
+
+    /// What the count's search relies on: no angle under 12.5° by the
+    /// tangent test means a min dihedral of at least 12°, also for the
+    /// flat and needle tets of CAD parts.
+    #[test]
+    fn no_angle_under_12_5_by_tangent_means_at_least_12_degrees() {
+        use crate::quality::{has_dihedral_under, min_dihedral_deg};
+        let mut r = crate::test_rng(0x5eed_1234);
+        let mut checked = 0;
+        for i in 0..200_000 {
+            // Regular-ish, flattened and stretched tets.
+            let squash = [1.0, 0.3, 0.05, 1e-3][i % 4];
+            let p: [[f64; 3]; 4] = std::array::from_fn(|_| [r(), r(), squash * r()]);
+            if !has_dihedral_under(p, super::TAN_12_5) {
+                checked += 1;
+                assert!(min_dihedral_deg(p) >= 12.0, "{p:?}");
+            }
+        }
+        assert!(checked > 1000, "{checked}");
     }
 }

@@ -6,7 +6,7 @@
 //! mesh and keeps it only when the worst quality of the tets it makes
 //! beats the worst of those it replaces, and every new tet is positive
 //! under the exact predicate and in floating point.
-use crate::quality::{min_dihedral_deg, positive_quality, quality};
+use crate::quality::{has_dihedral_under, min_dihedral_deg, positive_quality, quality};
 use crate::work::{ring_tets, Work, MAX_RING};
 use parafront_geom::{cross, dist2, norm, sub, P3};
 use parafront_mesh::{PointId, TET_FACES};
@@ -630,20 +630,31 @@ impl Work<'_> {
         // (tets under 10°, shortfall below 12°, min dihedral) with p at pos;
         // None when a tet inverts, more than `cap` are under 10° or one is
         // under `floor` (the search's bounds, checked as it goes).
-        let eval = |w: &Self, pos: P3, cap: usize, floor: f64| -> Option<(usize, f64, f64)> {
-            let (mut under, mut short, mut dmin) = (0, 0.0, f64::INFINITY);
-            for &t in ball {
-                let x = w.pts_moved(t, p, pos);
-                let d = min_dihedral_deg(x);
-                under += usize::from(d < crate::insert::SMALL_DIHEDRAL);
-                if under > cap || d < floor || !positive(x) {
-                    return None;
+        // `fast`: the search's steps, whose min dihedral is not read.
+        let eval =
+            |w: &Self, pos: P3, cap: usize, floor: f64, fast: bool| -> Option<(usize, f64, f64)> {
+                let (mut under, mut short, mut dmin) = (0, 0.0, f64::INFINITY);
+                for &t in ball {
+                    let x = w.pts_moved(t, p, pos);
+                    // A tet with no angle under 12.5° (the tangent test, no arc
+                    // tangent) adds nothing to the count or the shortfall and
+                    // passes a floor under 12°: only its sign matters.
+                    if fast && floor < 12.0 && !has_dihedral_under(x, crate::TAN_12_5) {
+                        if !positive(x) {
+                            return None;
+                        }
+                        continue;
+                    }
+                    let d = min_dihedral_deg(x);
+                    under += usize::from(d < crate::insert::SMALL_DIHEDRAL);
+                    if under > cap || d < floor || !positive(x) {
+                        return None;
+                    }
+                    short += (12.0 - d).max(0.0);
+                    dmin = dmin.min(d);
                 }
-                short += (12.0 - d).max(0.0);
-                dmin = dmin.min(d);
-            }
-            Some((under, short, dmin))
-        };
+                Some((under, short, dmin))
+            };
         let better = |a: (usize, f64, f64), b: (usize, f64, f64)| {
             a.0 < b.0 || (a.0 == b.0 && a.1 < b.1 - 1e-9)
         };
@@ -652,7 +663,7 @@ impl Work<'_> {
             s.nb.iter()
                 .map(|x| dist2(self.m.points[x.idx()], p0).sqrt())
                 .fold(f64::INFINITY, f64::min);
-        let Some(e0) = eval(self, p0, usize::MAX, f64::NEG_INFINITY) else {
+        let Some(e0) = eval(self, p0, usize::MAX, f64::NEG_INFINITY, false) else {
             return Outcome::NotBetter;
         };
         let (best, pos) = compass(
@@ -661,7 +672,7 @@ impl Work<'_> {
             0.3 * len,
             1e-2 * len,
             20,
-            |c, cur| eval(self, c, cur.0, e0.2),
+            |c, cur| eval(self, c, cur.0, e0.2, true),
             |a, b| better(*a, *b),
         );
         if best.0 < e0.0 {
