@@ -181,10 +181,11 @@ struct MeshArgs {
     /// front would give up.
     #[arg(long, value_name = "ROUNDS", default_value_t = parafront_front::DEFAULT_FILL_AFTER)]
     fill_after: u32,
-    /// Optimal space-filling tets (§2): the serial front leaves the
-    /// interior, where the size field is nearly uniform, to a BCC lattice
-    /// of near-ideal tets and meshes only around it. auto: when the size
-    /// field has a largest size (--size or --hmax); on; off
+    /// Optimal space-filling tets (§2): the front (serial, or the passes
+    /// of --parts) leaves the interior, where the size field is nearly
+    /// uniform, to a BCC lattice of near-ideal tets and meshes only around
+    /// it. auto: when the size field has a largest size (--size or
+    /// --hmax); on; off. --pvtu turns it off (its tets are in no piece)
     #[arg(long, value_name = "MODE", default_value = "auto")]
     lattice: parafront_pipeline::LatticeMode,
     /// With --parts > 1: a region less deep than this many mean surface
@@ -365,6 +366,10 @@ fn mesh_options(a: &MeshArgs) -> Result<MeshOptions, Fail> {
     o.ddg_growth = a.ddg_growth.unwrap_or(0.0);
     o.partition = a.partition;
     o.ddg_passes = a.ddg_passes;
+    if a.pvtu.is_some() {
+        // The pieces are the passes' parts; the lattice's tets are in none.
+        o.lattice = parafront_pipeline::LatticeMode::Off;
+    }
     if a.pvtu.is_some() && o.optimize > 0 {
         // The pieces are the generation's partition (§8); improvement
         // (§9) changes the mesh after it and does not renumber them yet.

@@ -205,6 +205,14 @@ impl Locator {
         {
             return Some(part[h as usize]);
         }
+        // A tet that holds `p` strictly is its only host: the common case,
+        // found without testing the bin's other tets.
+        for &t in self.bins.at(p) {
+            if self.bins.boxes[t as usize].contains(p) && self.strictly_holds(t, p) {
+                hint.store(t, Ordering::Relaxed);
+                return Some(part[t as usize]);
+            }
+        }
         let mut own: Option<u32> = None;
         let mut first = u32::MAX;
         let mut hosts = 0;

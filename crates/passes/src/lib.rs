@@ -472,6 +472,25 @@ pub fn mesh_parallel<C: Comm>(
     opts: &ParOptions,
     comm: &C,
 ) -> Result<ParOutput, PassError> {
+    mesh_parallel_around(points, point_size, faces, &[], size, opts, comm)
+}
+
+/// [`mesh_parallel`] around a filled core: `core` are the outer faces of
+/// tets made already (the lattice of §2's optimal space-filling tets),
+/// their normals pointing out of the core into the space left, over
+/// points that follow the surface's in `points`. The DDG and its partition
+/// cover the region as `faces` bound it, the fronts start from both, and
+/// no part is seeded (a part with no face lies inside the core). The
+/// output holds every point of `points` in order.
+pub fn mesh_parallel_around<C: Comm>(
+    points: &[P3],
+    point_size: &[f64],
+    faces: &[[u32; 3]],
+    core: &[[u32; 3]],
+    size: &(dyn Fn(P3) -> f64 + Sync),
+    opts: &ParOptions,
+    comm: &C,
+) -> Result<ParOutput, PassError> {
     let np = comm.parts();
     assert_eq!(
         comm.owned(),
@@ -485,14 +504,32 @@ pub fn mesh_parallel<C: Comm>(
     // §5 step 1: the DDG (replicated: it is small).
     let mut rec = Recorder::new(np);
     let t_ddg = Instant::now();
-    let (d, built) = the_ddg(points, point_size, faces, depth, opts, comm)?;
+    // The surface's points only: the core's are no candidates for the DDG.
+    let n_surface = faces.iter().flatten().max().map_or(0, |&v| v as usize + 1);
+    let (d, built) = the_ddg(
+        &points[..n_surface],
+        &point_size[..n_surface],
+        faces,
+        depth,
+        opts,
+        comm,
+    )?;
     rec.ddg(&d, built, t_ddg.elapsed().as_secs_f64());
     // §6 step 2: weights and the balanced split.
     let (loc, w, base) = split_ddg(&d, size, opts, np, &mut rec);
 
+    let all: Vec<[u32; 3]>;
+    let faces = if core.is_empty() {
+        faces
+    } else {
+        all = faces.iter().chain(core).copied().collect();
+        &all[..]
+    };
     let mut parts = seed_parts(np, points, point_size, faces);
     let mut next_gid = points.len() as u32;
-    rec.st.seeds = seed_inner_parts(&mut parts, &d, &loc, &base, size, &mut next_gid);
+    if core.is_empty() {
+        rec.st.seeds = seed_inner_parts(&mut parts, &d, &loc, &base, size, &mut next_gid);
+    }
     // §7 step 3, passes 1 to 3 and the crossing passes.
     let mut on = Partitions::new(base);
     let passes = Passes {

@@ -17,7 +17,7 @@ use parafront_ddg::DdgError;
 use parafront_front::{advance, FrontError, FrontInput, FrontOptions, SizeMode};
 use parafront_lattice::{Lattice, LatticeOptions};
 use parafront_mesh::{CheckError, PointId, QualityReport, TetMesh, TopoError};
-use parafront_passes::{mesh_parallel, ParOptions, ParOutput, PassError};
+use parafront_passes::{mesh_parallel_around, ParOptions, ParOutput, PassError};
 pub use parafront_passes::{process_cpu_seconds, DDG_CAP, SERIAL_FROM, THIN_DEPTH};
 use parafront_size::{SizeError, SizeField, SizeOptions, Sizing};
 use parafront_surface::validate::{shells, validate, Report, Shell, ShellKind};
@@ -299,16 +299,17 @@ fn mesh_surface_here(s: &Surface, opts: &MeshOptions) -> Result<(TetMesh, Summar
     let mut mesh = surface_mesh(s);
     let mut lattice_inner: Vec<u32> = Vec::new();
     if opts.parts > 1 {
-        mesh_parts(
+        lattice_inner = mesh_parts(
             s,
             &fronts,
             &sizing,
             opts,
             &mut mesh,
             &mut sum,
-            mesh_parallel,
+            mesh_parallel_around,
         )?;
     } else {
+        let lat0 = sum.seconds(Stage::Lattice);
         mesh_serial(
             s,
             &fronts,
@@ -318,7 +319,8 @@ fn mesh_surface_here(s: &Surface, opts: &MeshOptions) -> Result<(TetMesh, Summar
             &mut sum,
             &mut lattice_inner,
         )?;
-        sum.push(Stage::Front, t0.elapsed().as_secs_f64());
+        let lat = sum.seconds(Stage::Lattice) - lat0;
+        sum.push(Stage::Front, t0.elapsed().as_secs_f64() - lat);
     }
 
     if opts.optimize > 0 {
@@ -435,29 +437,7 @@ fn serial_region(
     // §2's optimal space-filling tets: the lattice's points follow the
     // surface's, its outer faces join the initial front.
     let n_in = points.len() as u32;
-    let t_lat = Instant::now();
-    let use_lattice = match opts.lattice {
-        LatticeMode::On => true,
-        LatticeMode::Off => false,
-        LatticeMode::Auto => sizing.hmax().is_finite(),
-    };
-    let lattice = if use_lattice {
-        parafront_lattice::build(
-            &points,
-            &point_size,
-            &rf.faces,
-            &field,
-            &LatticeOptions::default(),
-        )
-    } else {
-        Lattice::default()
-    };
-    tracing::debug!(
-        region = rf.region_id,
-        tets = lattice.tets.len(),
-        seconds = t_lat.elapsed().as_secs_f64(),
-        "lattice"
-    );
+    let lattice = region_lattice(&points, &point_size, rf, sizing, opts, sum);
     points.extend_from_slice(&lattice.points);
     point_size.extend_from_slice(&lattice.size);
     faces.extend(lattice.faces.iter().map(|f| f.map(|v| v + n_in)));
@@ -509,7 +489,57 @@ fn serial_region(
     let mut tets = res.tets;
     tets.extend(lattice.tets.iter().map(|t| t.map(|v| v + n_in)));
     let base = append_region(mesh, rf, &res.points, &tets);
-    // The lattice's points are the region's first new points.
+    note_lattice(&lattice, base, sum, lattice_inner);
+    sum.recovery_rounds += res.stats.recovery_rounds;
+    sum.tets_removed += res.stats.tets_removed;
+    sum.cavities_filled += res.stats.cavities_filled;
+    sum.fill_tets += res.stats.fill_tets;
+    Ok(())
+}
+
+/// §2's optimal space-filling tets in region `rf` (its surface points
+/// `points`), or none where `opts.lattice` turns them off or the size
+/// field has no bound.
+fn region_lattice(
+    points: &[parafront_geom::P3],
+    point_size: &[f64],
+    rf: &RegionFront,
+    sizing: &Sizing,
+    opts: &MeshOptions,
+    sum: &mut Summary,
+) -> Lattice {
+    let t_lat = Instant::now();
+    let use_lattice = match opts.lattice {
+        LatticeMode::On => true,
+        LatticeMode::Off => false,
+        LatticeMode::Auto => sizing.hmax().is_finite(),
+    };
+    let lattice = if use_lattice {
+        parafront_lattice::build(
+            points,
+            point_size,
+            &rf.faces,
+            &|p| sizing.size(p),
+            &LatticeOptions::default(),
+        )
+    } else {
+        Lattice::default()
+    };
+    tracing::debug!(
+        region = rf.region_id,
+        tets = lattice.tets.len(),
+        seconds = t_lat.elapsed().as_secs_f64(),
+        "lattice"
+    );
+    if !lattice.tets.is_empty() {
+        sum.push(Stage::Lattice, t_lat.elapsed().as_secs_f64());
+    }
+    lattice
+}
+
+/// The lattice's share of the summary, and its inner points (the region's
+/// first new points, from `base`), which improvement leaves alone.
+fn note_lattice(lattice: &Lattice, base: u32, sum: &mut Summary, lattice_inner: &mut Vec<u32>) {
     lattice_inner.extend(
         (0..lattice.points.len() as u32)
             .filter(|&k| lattice.interior[k as usize])
@@ -517,11 +547,6 @@ fn serial_region(
     );
     sum.lattice_tets += lattice.tets.len();
     sum.lattice_cells += lattice.cells;
-    sum.recovery_rounds += res.stats.recovery_rounds;
-    sum.tets_removed += res.stats.tets_removed;
-    sum.cavities_filled += res.stats.cavities_filled;
-    sum.fill_tets += res.stats.fill_tets;
-    Ok(())
 }
 
 /// A region's surface points, in its local order, and their sizes (AG3).
@@ -579,7 +604,10 @@ fn mesh_parts(
     mesh: &mut TetMesh,
     sum: &mut Summary,
     parallel: ParallelMesher,
-) -> Result<(), MeshError> {
+) -> Result<Vec<u32>, MeshError> {
+    // The lattice's inner points, for improvement to leave alone.
+    let mut inner = Vec::new();
+    let lattice_inner = &mut inner;
     let field = |p| sizing.size(p);
     let popts = ParOptions {
         parts: opts.parts,
@@ -602,9 +630,16 @@ fn mesh_parts(
     // Seconds of each of `Stage::PARALLEL`, summed over the regions.
     let mut stage = [0.0f64; Stage::PARALLEL.len()];
     for rf in fronts {
-        let (pts, hs) = region_points(s, sizing, rf);
+        let (mut pts, mut hs) = region_points(s, sizing, rf);
         let t_par = Instant::now();
-        let out = match parallel(&pts, &hs, &rf.faces, &field, &popts, &comm) {
+        // The lattice fills the core; the passes mesh the layer between it
+        // and the surface.
+        let n_in = pts.len() as u32;
+        let lattice = region_lattice(&pts, &hs, rf, sizing, opts, sum);
+        pts.extend_from_slice(&lattice.points);
+        hs.extend_from_slice(&lattice.size);
+        let core: Vec<[u32; 3]> = lattice.faces.iter().map(|f| f.map(|v| v + n_in)).collect();
+        let out = match parallel(&pts, &hs, &rf.faces, &core, &field, &popts, &comm) {
             Ok(out) => out,
             // A valid surface must not fail (AF5, step 4): a front the
             // passes leave unclosable (CAD needles next to a part wall) gets
@@ -624,8 +659,10 @@ fn mesh_parts(
                     .push((rf.region_id as usize, e.to_string()));
                 sum.push(Stage::PassesGivenUp, t_par.elapsed().as_secs_f64());
                 let t0 = Instant::now();
-                serial_region(s, rf, sizing, opts, mesh, sum, &mut Vec::new())?;
-                sum.push(Stage::Front, t0.elapsed().as_secs_f64());
+                let lat0 = sum.seconds(Stage::Lattice);
+                serial_region(s, rf, sizing, opts, mesh, sum, lattice_inner)?;
+                let lat = sum.seconds(Stage::Lattice) - lat0;
+                sum.push(Stage::Front, t0.elapsed().as_secs_f64() - lat);
                 continue;
             }
             Err(e) => {
@@ -635,7 +672,10 @@ fn mesh_parts(
                 })
             }
         };
-        let base = append_region(mesh, rf, &out.points, &out.tets);
+        let mut tets = out.tets;
+        tets.extend(lattice.tets.iter().map(|t| t.map(|v| v + n_in)));
+        let base = append_region(mesh, rf, &out.points, &tets);
+        note_lattice(&lattice, base, sum, lattice_inner);
         let st = &out.stats;
         for (k, x) in [
             st.ddg_seconds,
@@ -651,26 +691,31 @@ fn mesh_parts(
         {
             stage[k] += x;
         }
-        for mut pc in out.pieces {
-            for g in &mut pc.gid {
-                *g = global_id(rf, base, *g);
+        // The lattice's tets are in no piece: no pieces then (`--pvtu`
+        // turns the lattice off).
+        if lattice.tets.is_empty() {
+            for mut pc in out.pieces {
+                for g in &mut pc.gid {
+                    *g = global_id(rf, base, *g);
+                }
+                sum.pieces.push(pc);
             }
-            sum.pieces.push(pc);
         }
         sum.parallel.push(out.stats);
     }
     if sum.parallel.is_empty() {
-        return Ok(()); // every region went to the serial front
+        return Ok(inner); // every region went to the serial front
     }
     for (name, x) in Stage::PARALLEL.into_iter().zip(stage) {
         sum.push(name, x);
     }
-    Ok(())
+    Ok(inner)
 }
 
 type ParallelMesher = fn(
     &[parafront_geom::P3],
     &[f64],
+    &[[u32; 3]],
     &[[u32; 3]],
     &(dyn Fn(parafront_geom::P3) -> f64 + Sync),
     &ParOptions,
@@ -689,6 +734,7 @@ mod tests {
         fn stuck(
             _: &[parafront_geom::P3],
             _: &[f64],
+            _: &[[u32; 3]],
             _: &[[u32; 3]],
             _: &(dyn Fn(parafront_geom::P3) -> f64 + Sync),
             _: &ParOptions,

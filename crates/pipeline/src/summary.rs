@@ -14,6 +14,9 @@ pub enum Stage {
     /// The serial front (§4), or the serial front of a region the parallel
     /// passes gave up.
     Front,
+    /// §2's optimal space-filling tets: the lattice in the core of each
+    /// region, before the front or the passes mesh around it.
+    Lattice,
     /// The domain-defining grid (§5, step 1).
     Ddg,
     /// Its weights and balanced split, and the shifted partitions (§6,
@@ -59,6 +62,7 @@ impl Stage {
             Stage::Validate => "validate",
             Stage::SizeField => "size field",
             Stage::Front => "front",
+            Stage::Lattice => "lattice",
             Stage::Ddg => "ddg",
             Stage::Partition => "partition",
             Stage::Pass1 => "pass 1",

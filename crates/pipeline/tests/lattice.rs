@@ -13,7 +13,18 @@ fn run(
     lattice: LatticeMode,
     threads: usize,
 ) -> (parafront_mesh::TetMesh, usize) {
+    run_parts(s, h, lattice, threads, 1)
+}
+
+fn run_parts(
+    s: &Surface,
+    h: f64,
+    lattice: LatticeMode,
+    threads: usize,
+    parts: usize,
+) -> (parafront_mesh::TetMesh, usize) {
     let o = MeshOptions {
+        parts,
         size: SizeOptions {
             h: Some(h),
             ..SizeOptions::default()
@@ -26,6 +37,11 @@ fn run(
         ..MeshOptions::default()
     };
     let (m, sum) = mesh_surface(s, &o).unwrap_or_else(|e| panic!("meshing failed: {e}"));
+    assert!(
+        sum.serial_fallback.is_empty(),
+        "passes given up: {:?}",
+        sum.serial_fallback
+    );
     m.check_against_surface(&s.tris)
         .unwrap_or_else(|e| panic!("invalid mesh: {e}"));
     assert_eq!(QualityReport::new(&m).n_inverted, 0);
@@ -80,4 +96,23 @@ fn auto_leaves_the_graded_default_to_the_front() {
         .unwrap();
     assert_eq!(lat, 0);
     assert!(!m.tets.is_empty());
+}
+
+/// The lattice fits the passes as it fits the serial front (issue 21):
+/// the passes mesh the layer between it and the surface, the mesh is
+/// valid, the same on any thread count, and about the serial one's size.
+#[test]
+fn the_passes_mesh_around_the_lattice() {
+    let s = generate::icosphere([0.0; 3], 1.0, 4);
+    let (serial, ls) = run(&s, 0.06, LatticeMode::Auto, 2);
+    let (a, la) = run_parts(&s, 0.06, LatticeMode::Auto, 1, 4);
+    let (b, lb) = run_parts(&s, 0.06, LatticeMode::Auto, 2, 4);
+    assert!(la > 0 && la == ls && la == lb, "{la} {ls} {lb}");
+    assert!(la * 3 > a.tets.len(), "{la} of {}", a.tets.len());
+    assert_eq!(a.tets, b.tets);
+    assert_eq!(a.points, b.points);
+    let (n, m) = (a.tets.len() as f64, serial.tets.len() as f64);
+    assert!((n - m).abs() < 0.1 * m, "{n} tets against {m} serially");
+    assert!((volume(&a) - volume(&serial)).abs() < 1e-9 * volume(&serial));
+    assert!(QualityReport::new(&a).min_dihedral.min > 10.0);
 }

@@ -5,11 +5,14 @@ use parafront_pipeline::{mesh_surface, MeshOptions};
 use parafront_surface::generate;
 
 fn opts(parts: usize, h: f64) -> MeshOptions {
-    // Generation only: improvement changes the mesh after the passes.
+    // Generation only: improvement changes the mesh after the passes. No
+    // lattice: its tets are in no piece (tests/lattice.rs has the passes
+    // around one).
     let mut o = MeshOptions {
         parts,
         optimize: 0,
         regions: true,
+        lattice: parafront_pipeline::LatticeMode::Off,
         ..MeshOptions::default()
     };
     o.size.h = Some(h);
