@@ -63,8 +63,17 @@ pub fn build(
     size: &(dyn Fn(P3) -> f64 + Sync),
     opts: &LatticeOptions,
 ) -> Lattice {
+    let t0 = std::time::Instant::now();
     let cells = octree::blocks(points, point_size, faces, size, opts);
-    bcc::tetrahedralize(&cells)
+    let t1 = t0.elapsed().as_secs_f64();
+    let l = bcc::tetrahedralize(&cells);
+    tracing::debug!(
+        cells = cells.cells.len(),
+        blocks_s = t1,
+        tets_s = t0.elapsed().as_secs_f64() - t1,
+        "lattice built"
+    );
+    l
 }
 
 #[cfg(test)]

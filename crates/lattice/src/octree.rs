@@ -3,6 +3,7 @@
 use crate::inside::Inside;
 use crate::{LatticeOptions, CUBE_PER_SIZE};
 use parafront_geom::P3;
+use rayon::prelude::*;
 use rustc_hash::{FxHashMap, FxHashSet};
 
 /// Accepted cells: cell `(d, ijk)` is the cube of side `root / 2^d` at
@@ -59,7 +60,35 @@ pub(crate) fn blocks(
         cells: Vec::new(),
     };
     let inside = Inside::new(points, faces);
-    walk(&mut out, &fb, &inside, size, hmin, hmax, opts.margin);
+    let w = Walk {
+        origin: out.origin,
+        root,
+        fb: &fb,
+        inside: &inside,
+        size,
+        hmin,
+        hmax,
+        margin: opts.margin,
+    };
+    // The top levels in order, then their subtrees in parallel (the cells
+    // are sorted at the end, so the thread count does not show).
+    let all: Vec<u32> = (0..fb.len() as u32).collect();
+    let mut top = Vec::new();
+    w.run(
+        vec![(0, [0; 3], all, false)],
+        Some(PAR_DEPTH),
+        &mut out.cells,
+        &mut top,
+    );
+    let below: Vec<Vec<(u32, [i64; 3])>> = top
+        .into_par_iter()
+        .map(|p| {
+            let mut cells = Vec::new();
+            w.run(vec![p], None, &mut cells, &mut Vec::new());
+            cells
+        })
+        .collect();
+    out.cells.extend(below.into_iter().flatten());
     separate(&mut out);
     manifold(&mut out);
     drop_small(&mut out, opts.min_cells);
@@ -149,60 +178,84 @@ fn too_thin(points: &[P3], faces: &[[u32; 3]], lo: P3, hmean: f64, margin: f64) 
 /// its margin, and whether it is known to be inside.
 type Pending = (u32, [i64; 3], Vec<u32>, bool);
 
-/// The octree walk: a cell with surface within its margin is split where
-/// a child could fit the local size; a clear cell inside is kept when the
-/// size at its corners and centre is within its band, else split when the
-/// size is smaller.
-fn walk(
-    out: &mut Cells,
-    fb: &[(P3, P3)],
-    inside: &Inside,
-    size: &(dyn Fn(P3) -> f64 + Sync),
+/// The depth from which the octree's subtrees are walked in parallel:
+/// 8^3 of them at most.
+const PAR_DEPTH: u32 = 3;
+
+/// The octree walk's inputs.
+struct Walk<'a> {
+    origin: P3,
+    root: f64,
+    fb: &'a [(P3, P3)],
+    inside: &'a Inside<'a>,
+    size: &'a (dyn Fn(P3) -> f64 + Sync),
     hmin: f64,
     hmax: f64,
     margin: f64,
-) {
-    let band = std::f64::consts::SQRT_2;
-    let all: Vec<u32> = (0..fb.len() as u32).collect();
-    let mut stack: Vec<Pending> = vec![(0, [0; 3], all, false)];
-    while let Some((d, ijk, near, known_in)) = stack.pop() {
-        let s = out.side(d);
-        let h = s / CUBE_PER_SIZE;
-        if h < hmin / band || d > MAX_DEPTH {
-            continue;
-        }
-        let a = out.corner(d, ijk);
-        if !near.is_empty() {
-            // Split only where a child could fit the local size: with the
-            // cell's samples all over a child's band (a quarter of slack
-            // for the size between them) there is nothing to gain.
-            let hc = 0.5 * h * band * 1.25;
-            let fine = hc >= hmax || (0..9).any(|b| size(sample(a, s, b)) <= hc);
-            if fine {
-                split(&mut stack, fb, &near, false, (d, ijk, a, s), margin);
+}
+
+impl Walk<'_> {
+    fn side(&self, d: u32) -> f64 {
+        self.root / (1u64 << d) as f64
+    }
+
+    /// The octree walk from the cells on `stack`: a cell with surface
+    /// within its margin is split where a child could fit the local size;
+    /// a clear cell inside is kept (into `cells`) when the size at its
+    /// corners and centre is within its band, else split when the size is
+    /// smaller. Cells at depth `stop` go to `left` instead.
+    fn run(
+        &self,
+        mut stack: Vec<Pending>,
+        stop: Option<u32>,
+        cells: &mut Vec<(u32, [i64; 3])>,
+        left: &mut Vec<Pending>,
+    ) {
+        let band = std::f64::consts::SQRT_2;
+        let (fb, size, margin) = (self.fb, self.size, self.margin);
+        while let Some((d, ijk, near, known_in)) = stack.pop() {
+            if stop == Some(d) {
+                left.push((d, ijk, near, known_in));
+                continue;
             }
-            continue;
-        }
-        // No surface within the margin: the whole cell is in or out.
-        if !known_in && !cell_inside(inside, a, s) {
-            continue;
-        }
-        if h / band > hmax {
-            // Larger than any size in the region: only children can fit.
-            split(&mut stack, fb, &[], true, (d, ijk, a, s), margin);
-            continue;
-        }
-        let mut small = false;
-        let mut fits = true;
-        for b in 0..9 {
-            let hp = size(sample(a, s, b));
-            small |= hp < h / band;
-            fits &= hp >= h / band && hp <= h * band;
-        }
-        if fits {
-            out.cells.push((d, ijk));
-        } else if small {
-            split(&mut stack, fb, &[], true, (d, ijk, a, s), margin);
+            let s = self.side(d);
+            let h = s / CUBE_PER_SIZE;
+            if h < self.hmin / band || d > MAX_DEPTH {
+                continue;
+            }
+            let a = [0, 1, 2].map(|k| self.origin[k] + ijk[k] as f64 * s);
+            if !near.is_empty() {
+                // Split only where a child could fit the local size: with
+                // the cell's samples all over a child's band (a quarter of
+                // slack for the size between them) there is nothing to gain.
+                let hc = 0.5 * h * band * 1.25;
+                let fine = hc >= self.hmax || (0..9).any(|b| size(sample(a, s, b)) <= hc);
+                if fine {
+                    split(&mut stack, fb, &near, false, (d, ijk, a, s), margin);
+                }
+                continue;
+            }
+            // No surface within the margin: the whole cell is in or out.
+            if !known_in && !cell_inside(self.inside, a, s) {
+                continue;
+            }
+            if h / band > self.hmax {
+                // Larger than any size in the region: only children can fit.
+                split(&mut stack, fb, &[], true, (d, ijk, a, s), margin);
+                continue;
+            }
+            let mut small = false;
+            let mut fits = true;
+            for b in 0..9 {
+                let hp = size(sample(a, s, b));
+                small |= hp < h / band;
+                fits &= hp >= h / band && hp <= h * band;
+            }
+            if fits {
+                cells.push((d, ijk));
+            } else if small {
+                split(&mut stack, fb, &[], true, (d, ijk, a, s), margin);
+            }
         }
     }
 }
