@@ -67,6 +67,10 @@ SETS = {
     # the same size. The lattice (§2) fills the interior.
     "bench1e6size": [("bench/sphere_1e6.stl", ["--size", "0.037"]),
                      ("bench/torus_1e6.stl", ["--size", "0.032"])],
+    # The same on the parallel passes (2 parts), around the lattice; the
+    # peers' rows are bench1e6size's.
+    "bench1e6parts": [("bench/sphere_1e6.stl", ["--size", "0.037", "--parts", "2"]),
+                      ("bench/torus_1e6.stl", ["--size", "0.032", "--parts", "2"])],
     "bench5e6": [(f"bench/{n}_5e6.stl", []) for n in ["sphere"]],
 }
 
@@ -205,6 +209,8 @@ def main():
             mesh = os.path.join(work, name + ".vtu")
             if "--size" in extra:
                 name += " --size " + extra[extra.index("--size") + 1]
+            if "--parts" in extra:
+                name += " --parts " + extra[extra.index("--parts") + 1]
             healed = None
             if "--heal" in extra:
                 healed = os.path.join(work, name + ".healed.stl")
@@ -234,6 +240,8 @@ def main():
                         stages.setdefault(k, []).append(v)
                 stage_rows.append((name, t, {k: median(v) for k, v in stages.items()}))
                 print(f"{name} parafront {t}: {tets} tets {wall:.2f} s valid={valid}", file=sys.stderr)
+            if "--parts" in extra:
+                continue  # the peers have no parts: their rows are the serial set's
             # Peers mesh what parafront meshed: the healed surface for dirty/.
             peer_surf = healed if healed and os.path.exists(healed) else surf
             h = extra[extra.index("--size") + 1] if "--size" in extra else "auto"
