@@ -104,8 +104,12 @@ def parse_summary(out):
         r["points"] = int(m.group(2))
     m = re.search(r"^seconds: (.*) \(total ([\d.]+), (\d+) threads?\)", out, re.M)
     if m:
-        r["stages"] = {k: float(v) for k, v in re.findall(r"([a-z ]+) ([\d.]+)", m.group(1))}
-        r["stages"] = {k.strip(): v for k, v in r["stages"].items()}
+        # "name seconds" pairs, comma-separated; names may hold digits
+        # ("pass 1 1.771").
+        r["stages"] = {}
+        for item in m.group(1).split(","):
+            k, _, v = item.strip().rpartition(" ")
+            r["stages"][k] = float(v)
         r["total"] = float(m.group(2))
     m = re.search(r"^quality: min dihedral ([\d.]+) deg, ([\d.]+)% of tets under 10 deg, "
                   r"mean radius ratio ([\d.]+)", out, re.M)

@@ -631,7 +631,6 @@ fn mesh_parts(
     let mut stage = [0.0f64; Stage::PARALLEL.len()];
     for rf in fronts {
         let (mut pts, mut hs) = region_points(s, sizing, rf);
-        let t_par = Instant::now();
         // The lattice fills the core; the passes mesh the layer between it
         // and the surface.
         let n_in = pts.len() as u32;
@@ -639,6 +638,7 @@ fn mesh_parts(
         pts.extend_from_slice(&lattice.points);
         hs.extend_from_slice(&lattice.size);
         let core: Vec<[u32; 3]> = lattice.faces.iter().map(|f| f.map(|v| v + n_in)).collect();
+        let t_par = Instant::now();
         let out = match parallel(&pts, &hs, &rf.faces, &core, &field, &popts, &comm) {
             Ok(out) => out,
             // A valid surface must not fail (AF5, step 4): a front the
