@@ -161,36 +161,41 @@ impl Locator {
             if !self.bins.boxes[t as usize].contains(p) {
                 continue;
             }
-            if self.closed_holds(t, p) && !f(t) {
+            if self.holds(t, p).is_some() && !f(t) {
                 return;
             }
         }
     }
 
-    /// Whether the closed tet `t` holds `p`: a corner of it (the surface
-    /// points are corners of DDG tets, and every predicate of a corner
-    /// takes the slow exact path), or no sub-tet with `p` in place of a
-    /// corner is negative.
+    /// Whether the closed tet `t` holds `p`: `Some(true)` strictly inside
+    /// (then `t` is its only host), `Some(false)` on its boundary, `None`
+    /// outside. A corner is on the boundary without a predicate (the
+    /// surface points are corners of DDG tets, and every predicate of a
+    /// corner takes the slow exact path); else no sub-tet with `p` in
+    /// place of a corner may be negative.
     #[inline]
-    fn closed_holds(&self, t: u32, p: P3) -> bool {
-        let [a, b, c, d] = self.tets[t as usize];
-        if p == a || p == b || p == c || p == d {
-            return true;
+    fn holds(&self, t: u32, p: P3) -> Option<bool> {
+        let q = self.tets[t as usize];
+        if q.contains(&p) {
+            return Some(false);
         }
-        orient3d(p, b, c, d) >= 0.0
-            && orient3d(a, p, c, d) >= 0.0
-            && orient3d(a, b, p, d) >= 0.0
-            && orient3d(a, b, c, p) >= 0.0
+        let mut strict = true;
+        for k in 0..4 {
+            let mut r = q;
+            r[k] = p;
+            let o = orient3d(r[0], r[1], r[2], r[3]);
+            if o < 0.0 {
+                return None;
+            }
+            strict &= o > 0.0;
+        }
+        Some(strict)
     }
 
     /// Whether `p` lies strictly inside tet `t`: then `t` is its only host.
     #[inline]
     pub fn strictly_holds(&self, t: u32, p: P3) -> bool {
-        let [a, b, c, d] = self.tets[t as usize];
-        orient3d(p, b, c, d) > 0.0
-            && orient3d(a, p, c, d) > 0.0
-            && orient3d(a, b, p, d) > 0.0
-            && orient3d(a, b, c, p) > 0.0
+        self.holds(t, p) == Some(true)
     }
 
     /// [`Locator::owner`], trying first the tet in `hint` (the last one
@@ -205,42 +210,40 @@ impl Locator {
         {
             return Some(part[h as usize]);
         }
-        // A tet that holds `p` strictly is its only host: the common case,
-        // found without testing the bin's other tets.
-        for &t in self.bins.at(p) {
-            if self.bins.boxes[t as usize].contains(p) && self.strictly_holds(t, p) {
-                hint.store(t, Ordering::Relaxed);
-                return Some(part[t as usize]);
-            }
-        }
+        // One scan of the bin: a tet that holds `p` strictly is its only
+        // host (the common case, answered there); else every host must be
+        // in one part.
         let mut own: Option<u32> = None;
         let mut first = u32::MAX;
         let mut hosts = 0;
-        let mut mixed = false;
-        self.hosts(p, |t| {
-            hosts += 1;
-            let k = part[t as usize];
-            match own {
-                None => {
-                    own = Some(k);
-                    first = t;
-                    true
+        for &t in self.bins.at(p) {
+            if !self.bins.boxes[t as usize].contains(p) {
+                continue;
+            }
+            match self.holds(t, p) {
+                None => {}
+                Some(true) => {
+                    hint.store(t, Ordering::Relaxed);
+                    return Some(part[t as usize]);
                 }
-                Some(o) if o == k => true,
-                Some(_) => {
-                    mixed = true;
-                    false
+                Some(false) => {
+                    hosts += 1;
+                    let k = part[t as usize];
+                    match own {
+                        None => {
+                            own = Some(k);
+                            first = t;
+                        }
+                        Some(o) if o == k => {}
+                        Some(_) => return None,
+                    }
                 }
             }
-        });
+        }
         if hosts == 1 {
             hint.store(first, Ordering::Relaxed);
         }
-        if mixed {
-            None
-        } else {
-            own
-        }
+        own
     }
 
     /// The part that holds `p` conservatively (§7): `Some(k)` when every

@@ -26,18 +26,8 @@ fn main() {
     for i in 0..faces.len() {
         for j in i + 1..faces.len() {
             let (a, b): ([u32; 3], [u32; 3]) = (faces[i], faces[j]);
-            let shared: Vec<u32> = a.iter().copied().filter(|v| b.contains(v)).collect();
-            let rot = |t: [u32; 3]| {
-                let mut r: Vec<u32> = shared.clone();
-                r.extend(t.iter().copied().filter(|v| !shared.contains(v)));
-                [r[0], r[1], r[2]]
-            };
-            let (ra, rb) = (rot(a), rot(b));
-            let pa = ra.map(|v| pts[v as usize]);
-            let pb = rb.map(|v| pts[v as usize]);
-            if shared.len() < 3
-                && parafront_geom::intersect::triangles_intersect(pa, pb, shared.len())
-            {
+            let twice = a.iter().all(|v| b.contains(v));
+            if !twice && parafront_geom::intersect::faces_meet(a, b, &pts) {
                 bad += 1;
                 if bad < 5 {
                     println!("faces {i} {a:?} and {j} {b:?} meet");

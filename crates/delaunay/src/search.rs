@@ -9,9 +9,7 @@
 //! tetrahedralization of their own points need one).
 use crate::flips::{key3, same_cycle};
 use crate::tri::TET_FACES;
-use parafront_geom::{
-    centroid3, dist, intersect::triangles_intersect, orient3d, tri_normal, Aabb, P3,
-};
+use parafront_geom::{centroid3, dist, intersect::faces_meet, orient3d, tri_normal, Aabb, P3};
 use std::collections::BTreeMap;
 
 /// A live face of the search's front, and the apexes it may take.
@@ -400,7 +398,7 @@ impl Search {
                 if key3(e.face) == key3(w) || !self.bbox(&e.face).overlaps(&wb) {
                     continue;
                 }
-                if self.meet(w, e.face) {
+                if faces_meet(w, e.face, &self.pts) {
                     return false;
                 }
             }
@@ -416,19 +414,8 @@ impl Search {
                 // The same face: only from its other side.
                 return !same_cycle(w, f);
             }
-            !self.meet(f, w)
+            !faces_meet(f, w, &self.pts)
         })
-    }
-
-    /// Whether triangles `a` and `b` meet beyond their shared corners.
-    fn meet(&self, a: [u32; 3], b: [u32; 3]) -> bool {
-        let shared: Vec<u32> = a.iter().copied().filter(|v| b.contains(v)).collect();
-        let order = |t: [u32; 3]| {
-            let mut r = shared.clone();
-            r.extend(t.iter().copied().filter(|v| !shared.contains(v)));
-            [r[0], r[1], r[2]].map(|v| self.pts[v as usize])
-        };
-        triangles_intersect(order(a), order(b), shared.len())
     }
 
     /// A point strictly inside the cavity for the search to use: in front

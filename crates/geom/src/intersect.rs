@@ -275,6 +275,48 @@ pub fn triangles_intersect(t1: [P3; 3], t2: [P3; 3], shared: usize) -> bool {
     }
 }
 
+/// Both triangles (vertex ids `a`, `b`, their points `ap`, `bp`) reordered
+/// so their common vertices come first, in the same order in both (in
+/// `a`'s order): what [`triangles_intersect`] expects.
+#[inline]
+pub fn shared_first(a: [u32; 3], ap: [P3; 3], b: [u32; 3], bp: [P3; 3]) -> ([P3; 3], [P3; 3]) {
+    let (mut oa, mut ob) = ([0usize; 3], [0usize; 3]);
+    let (mut ua, mut ub) = ([false; 3], [false; 3]);
+    let mut n = 0;
+    for i in 0..3 {
+        for j in 0..3 {
+            if a[i] == b[j] {
+                oa[n] = i;
+                ob[n] = j;
+                ua[i] = true;
+                ub[j] = true;
+                n += 1;
+            }
+        }
+    }
+    let (mut ka, mut kb) = (n, n);
+    for i in 0..3 {
+        if !ua[i] {
+            oa[ka] = i;
+            ka += 1;
+        }
+        if !ub[i] {
+            ob[kb] = i;
+            kb += 1;
+        }
+    }
+    (oa.map(|i| ap[i]), ob.map(|j| bp[j]))
+}
+
+/// Whether triangles `a` and `b` (vertex ids into `pts`) meet beyond the
+/// vertices they share ([`triangles_intersect`]; the same triangle meets
+/// itself).
+pub fn faces_meet(a: [u32; 3], b: [u32; 3], pts: &[P3]) -> bool {
+    let shared = a.iter().filter(|v| b.contains(v)).count();
+    let (pa, pb) = shared_first(a, a.map(|v| pts[v as usize]), b, b.map(|v| pts[v as usize]));
+    triangles_intersect(pa, pb, shared)
+}
+
 fn all_strict_same(s: [i8; 3]) -> bool {
     s.iter().all(|&x| x > 0) || s.iter().all(|&x| x < 0)
 }

@@ -61,8 +61,11 @@ pub(crate) fn blocks(
     };
     let inside = Inside::new(points, faces);
     let w = Walk {
-        origin: out.origin,
-        root,
+        grid: Cells {
+            origin: out.origin,
+            root,
+            cells: Vec::new(),
+        },
         fb: &fb,
         inside: &inside,
         size,
@@ -182,10 +185,9 @@ type Pending = (u32, [i64; 3], Vec<u32>, bool);
 /// 8^3 of them at most.
 const PAR_DEPTH: u32 = 3;
 
-/// The octree walk's inputs.
+/// The octree walk's inputs; `grid` places its cells (it holds none).
 struct Walk<'a> {
-    origin: P3,
-    root: f64,
+    grid: Cells,
     fb: &'a [(P3, P3)],
     inside: &'a Inside<'a>,
     size: &'a (dyn Fn(P3) -> f64 + Sync),
@@ -195,10 +197,6 @@ struct Walk<'a> {
 }
 
 impl Walk<'_> {
-    fn side(&self, d: u32) -> f64 {
-        self.root / (1u64 << d) as f64
-    }
-
     /// The octree walk from the cells on `stack`: a cell with surface
     /// within its margin is split where a child could fit the local size;
     /// a clear cell inside is kept (into `cells`) when the size at its
@@ -218,12 +216,12 @@ impl Walk<'_> {
                 left.push((d, ijk, near, known_in));
                 continue;
             }
-            let s = self.side(d);
+            let s = self.grid.side(d);
             let h = s / CUBE_PER_SIZE;
             if h < self.hmin / band || d > MAX_DEPTH {
                 continue;
             }
-            let a = [0, 1, 2].map(|k| self.origin[k] + ijk[k] as f64 * s);
+            let a = self.grid.corner(d, ijk);
             if !near.is_empty() {
                 // Split only where a child could fit the local size: with
                 // the cell's samples all over a child's band (a quarter of

@@ -297,9 +297,8 @@ fn mesh_surface_here(s: &Surface, opts: &MeshOptions) -> Result<(TetMesh, Summar
 
     let t0 = Instant::now();
     let mut mesh = surface_mesh(s);
-    let mut lattice_inner: Vec<u32> = Vec::new();
-    if opts.parts > 1 {
-        lattice_inner = mesh_parts(
+    let lattice_inner = if opts.parts > 1 {
+        mesh_parts(
             s,
             &fronts,
             &sizing,
@@ -307,21 +306,14 @@ fn mesh_surface_here(s: &Surface, opts: &MeshOptions) -> Result<(TetMesh, Summar
             &mut mesh,
             &mut sum,
             mesh_parallel_around,
-        )?;
+        )?
     } else {
         let lat0 = sum.seconds(Stage::Lattice);
-        mesh_serial(
-            s,
-            &fronts,
-            &sizing,
-            opts,
-            &mut mesh,
-            &mut sum,
-            &mut lattice_inner,
-        )?;
+        let inner = mesh_serial(s, &fronts, &sizing, opts, &mut mesh, &mut sum)?;
         let lat = sum.seconds(Stage::Lattice) - lat0;
         sum.push(Stage::Front, t0.elapsed().as_secs_f64() - lat);
-    }
+        inner
+    };
 
     if opts.optimize > 0 {
         // The report before improvement is the improvement's cost.
@@ -405,7 +397,8 @@ fn surface_mesh(s: &Surface) -> TetMesh {
     }
 }
 
-/// The serial front (§4) on each region, appended to `mesh`.
+/// The serial front (§4) on each region, appended to `mesh`; the lattice's
+/// inner points, for improvement to leave alone.
 fn mesh_serial(
     s: &Surface,
     fronts: &[RegionFront],
@@ -413,12 +406,12 @@ fn mesh_serial(
     opts: &MeshOptions,
     mesh: &mut TetMesh,
     sum: &mut Summary,
-    lattice_inner: &mut Vec<u32>,
-) -> Result<(), MeshError> {
+) -> Result<Vec<u32>, MeshError> {
+    let mut lattice_inner = Vec::new();
     for rf in fronts {
-        serial_region(s, rf, sizing, opts, mesh, sum, lattice_inner)?;
+        serial_region(s, rf, sizing, opts, mesh, sum, &mut lattice_inner)?;
     }
-    Ok(())
+    Ok(lattice_inner)
 }
 
 /// The serial front on region `r`, appended to `mesh`.
@@ -606,8 +599,7 @@ fn mesh_parts(
     parallel: ParallelMesher,
 ) -> Result<Vec<u32>, MeshError> {
     // The lattice's inner points, for improvement to leave alone.
-    let mut inner = Vec::new();
-    let lattice_inner = &mut inner;
+    let mut lattice_inner = Vec::new();
     let field = |p| sizing.size(p);
     let popts = ParOptions {
         parts: opts.parts,
@@ -660,7 +652,7 @@ fn mesh_parts(
                 sum.push(Stage::PassesGivenUp, t_par.elapsed().as_secs_f64());
                 let t0 = Instant::now();
                 let lat0 = sum.seconds(Stage::Lattice);
-                serial_region(s, rf, sizing, opts, mesh, sum, lattice_inner)?;
+                serial_region(s, rf, sizing, opts, mesh, sum, &mut lattice_inner)?;
                 let lat = sum.seconds(Stage::Lattice) - lat0;
                 sum.push(Stage::Front, t0.elapsed().as_secs_f64() - lat);
                 continue;
@@ -675,7 +667,7 @@ fn mesh_parts(
         let mut tets = out.tets;
         tets.extend(lattice.tets.iter().map(|t| t.map(|v| v + n_in)));
         let base = append_region(mesh, rf, &out.points, &tets);
-        note_lattice(&lattice, base, sum, lattice_inner);
+        note_lattice(&lattice, base, sum, &mut lattice_inner);
         let st = &out.stats;
         for (k, x) in [
             st.ddg_seconds,
@@ -704,12 +696,12 @@ fn mesh_parts(
         sum.parallel.push(out.stats);
     }
     if sum.parallel.is_empty() {
-        return Ok(inner); // every region went to the serial front
+        return Ok(lattice_inner); // every region went to the serial front
     }
     for (name, x) in Stage::PARALLEL.into_iter().zip(stage) {
         sum.push(name, x);
     }
-    Ok(inner)
+    Ok(lattice_inner)
 }
 
 type ParallelMesher = fn(

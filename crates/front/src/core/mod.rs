@@ -6,7 +6,7 @@ use crate::grid::LooseGrid;
 use crate::quality::candidate_score;
 use crate::queue::MinQueue;
 use crate::{RegionFilter, SizeMode};
-use parafront_geom::intersect::triangles_intersect;
+use parafront_geom::intersect::{shared_first, triangles_intersect};
 use parafront_geom::*;
 use parafront_mesh::TET_FACES;
 use rustc_hash::FxHashMap;
@@ -387,38 +387,6 @@ fn sorted3(v: [u32; 3]) -> [u32; 3] {
 #[inline]
 fn same_cycle(a: [u32; 3], b: [u32; 3]) -> bool {
     a == b || a == [b[1], b[2], b[0]] || a == [b[2], b[0], b[1]]
-}
-
-/// Both triangles reordered so their common vertices come first, in the
-/// same order (what `triangles_intersect` expects).
-#[inline]
-fn shared_first(a: [u32; 3], ap: [P3; 3], b: [u32; 3], bp: [P3; 3]) -> ([P3; 3], [P3; 3]) {
-    let (mut oa, mut ob) = ([0usize; 3], [0usize; 3]);
-    let (mut ua, mut ub) = ([false; 3], [false; 3]);
-    let mut n = 0;
-    for i in 0..3 {
-        for j in 0..3 {
-            if a[i] == b[j] {
-                oa[n] = i;
-                ob[n] = j;
-                ua[i] = true;
-                ub[j] = true;
-                n += 1;
-            }
-        }
-    }
-    let (mut ka, mut kb) = (n, n);
-    for i in 0..3 {
-        if !ua[i] {
-            oa[ka] = i;
-            ka += 1;
-        }
-        if !ub[i] {
-            ob[kb] = i;
-            kb += 1;
-        }
-    }
-    (oa.map(|i| ap[i]), ob.map(|j| bp[j]))
 }
 
 /// The L1 length of the box around `a` and `b`: a bound on the distance
