@@ -2,14 +2,17 @@
 //! flags into the library's option structs and calls one function.
 // Not forbid: resetting SIGPIPE (in `main`) needs one unsafe call.
 #![deny(unsafe_code)]
+#[cfg(feature = "mpi")]
+mod mpi_run;
 mod parallel;
 mod plot;
 mod surface_cmds;
 
 use clap::{Args, Parser, Subcommand};
+use parafront_comm::Comm;
 use parafront_io::{read_mesh, write_mesh, MshVersion, WriteOptions};
 use parafront_mesh::QualityReport;
-use parafront_pipeline::{mesh_surface, MeshError, MeshOptions, Stage, Summary};
+use parafront_pipeline::{mesh_surface_on, MeshError, MeshOptions, Stage, Summary};
 use parafront_surface::read::read_surface;
 use parafront_surface::validate::validate;
 use parafront_surface::Surface;
@@ -201,6 +204,10 @@ struct MeshArgs {
     /// fronts, as a share of a part's width.
     #[arg(long, value_name = "SHARE", default_value_t = parafront_pipeline::DDG_CAP)]
     ddg_cap: f64,
+    /// Test hook: redistribution fails on this part (the MPI tests'
+    /// failing rank).
+    #[arg(long, value_name = "PART", hide = true)]
+    fail_part: Option<usize>,
 }
 
 #[derive(Args)]
@@ -251,6 +258,53 @@ fn main() -> ExitCode {
                 .num_threads(t)
                 .build_global();
         }
+    }
+    // Under mpirun (feature `mpi`), `mesh` and `demo` run over the ranks.
+    #[cfg(feature = "mpi")]
+    let mut mpi = if mpi_run::launched() {
+        match mpi_run::start() {
+            Ok(m) => Some(m),
+            Err(Fail(code, msg)) => {
+                eprintln!("parafront: {msg}");
+                return ExitCode::from(code);
+            }
+        }
+    } else {
+        None
+    };
+    #[cfg(feature = "mpi")]
+    if let Some(m) = mpi.as_mut() {
+        let res = match cli.cmd {
+            Cmd::Demo {
+                output,
+                mesh,
+                write,
+                check_only: false,
+            } => {
+                let mut mesh = mesh;
+                mesh.regions = true;
+                let s = parafront_surface::generate::demo_part();
+                mpi_run::run_mesh(m, Ok((s, "demo part".into())), &output, &mesh, &write)
+            }
+            Cmd::Mesh {
+                surface,
+                output,
+                mesh,
+                heal,
+                write,
+            } => {
+                let input = read_surface(&surface)
+                    .map_err(Fail::from)
+                    .and_then(|s| surface_cmds::heal_for_mesh(s, &heal, &write))
+                    .map(|s| (s, surface.display().to_string()));
+                mpi_run::run_mesh(m, input, &output, &mesh, &write)
+            }
+            _ => Err(Fail(
+                2,
+                "under mpirun, only `mesh` and `demo` run (over the ranks)".into(),
+            )),
+        };
+        return exit(res);
     }
     let res = match cli.cmd {
         Cmd::Demo {
@@ -304,10 +358,18 @@ fn main() -> ExitCode {
             write,
         } => surface_cmds::run_convert(&input, &output, &write),
     };
+    exit(res)
+}
+
+/// The exit code, with the message on stderr (none when empty: an MPI
+/// rank other than 0).
+fn exit(res: Result<(), Fail>) -> ExitCode {
     match res {
         Ok(()) => ExitCode::SUCCESS,
         Err(Fail(code, msg)) => {
-            eprintln!("parafront: {msg}");
+            if !msg.is_empty() {
+                eprintln!("parafront: {msg}");
+            }
             ExitCode::from(code)
         }
     }
@@ -359,6 +421,7 @@ fn mesh_options(a: &MeshArgs) -> Result<MeshOptions, Fail> {
     o.thin_depth = a.thin_depth;
     o.serial_from = a.serial_from;
     o.ddg_cap = a.ddg_cap;
+    o.fail_part = a.fail_part;
     if a.parts == 0 {
         return Err(Fail(2, "--parts must be at least 1".into()));
     }
@@ -382,6 +445,21 @@ fn mesh_options(a: &MeshArgs) -> Result<MeshOptions, Fail> {
 }
 
 fn run_mesh(s: &Surface, name: &str, out: &Path, a: &MeshArgs, w: &WriteArgs) -> Result<(), Fail> {
+    let comm = parafront_comm::Threads::new(a.parts.max(1));
+    run_mesh_on(s, name, out, a, w, &comm, true)
+}
+
+/// [`run_mesh`] with the parts' messages through `comm`; only the `lead`
+/// process (the one the mesh gathers on) prints and writes.
+pub(crate) fn run_mesh_on<C: Comm>(
+    s: &Surface,
+    name: &str,
+    out: &Path,
+    a: &MeshArgs,
+    w: &WriteArgs,
+    comm: &C,
+    lead: bool,
+) -> Result<(), Fail> {
     let mut opts = mesh_options(a)?;
     let wopts = write_options(w, Some(s))?;
     if parafront_io::Format::from_path(out).is_none() {
@@ -393,18 +471,23 @@ fn run_mesh(s: &Surface, name: &str, out: &Path, a: &MeshArgs, w: &WriteArgs) ->
             ),
         ));
     }
-    println!(
-        "{name}: {} points, {} triangles",
-        s.points.len(),
-        s.tris.len()
-    );
-    let progress = std::sync::Arc::new(parafront_front::Progress::default());
-    opts.progress = Some(progress.clone());
-    let bar = ProgressLine::start(progress);
-    let res = mesh_surface(s, &opts);
-    bar.finish();
+    let bar = lead.then(|| {
+        println!(
+            "{name}: {} points, {} triangles",
+            s.points.len(),
+            s.tris.len()
+        );
+        let progress = std::sync::Arc::new(parafront_front::Progress::default());
+        opts.progress = Some(progress.clone());
+        ProgressLine::start(progress)
+    });
+    let res = mesh_surface_on(s, &opts, comm);
+    if let Some(bar) = bar {
+        bar.finish();
+    }
     let (mesh, mut sum) = match res {
-        Ok(r) => r,
+        Ok(Some(r)) => r,
+        Ok(None) => return Ok(()),
         Err(e) => {
             if let (Some(path), MeshError::Front { source, .. }) = (&a.debug_dump, &e) {
                 write_partial(path, source, &wopts);

@@ -6,10 +6,11 @@
 //!
 //! Every part keeps its own points, tets and front (`Part` is private to
 //! this module and only ever touched by the closure of its own part); parts
-//! see each other's data only through the messages of a [`Comm`]. The
-//! passes still hold every part in this process (`Comm::owned` is all of
-//! them, as with `Threads`); ARCHITECTURE.md says what a rank-local run
-//! under `Mpi` needs.
+//! see each other's data only through the messages of a [`Comm`]. A
+//! process holds the parts `Comm::owned` gives (all of them with
+//! `Threads`, a block of them per rank under MPI); the DDG and its
+//! partitions are replicated, and pass 4 runs on part 0's process, whose
+//! choices reach the others by all-gather.
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
@@ -66,6 +67,8 @@ pub struct ParOptions {
     /// On deep fronts, the DDG's largest size as a share of a part's width
     /// (the cube root of its volume).
     pub ddg_cap: f64,
+    /// Test hook: redistribution fails on this part ([`PassError::Injected`]).
+    pub fail_part: Option<usize>,
 }
 
 pub use ddg_build::DDG_CAP;
@@ -85,6 +88,7 @@ impl Default for ParOptions {
             thin_depth: THIN_DEPTH,
             serial_from: SERIAL_FROM,
             ddg_cap: ddg_build::DDG_CAP,
+            fail_part: None,
         }
     }
 }
@@ -135,6 +139,25 @@ pub enum PassError {
     Unsuited {
         /// The share of the volume left.
         left: f64,
+    },
+    /// A part held by another process failed (under MPI): every process
+    /// stops with its message, or falls back to the serial front as the
+    /// process holding the part does (which has the error itself).
+    #[error("{message} (on another process: the one holding part {part})")]
+    Remote {
+        /// The part.
+        part: usize,
+        /// The part's error, as its process printed it.
+        message: String,
+        /// The error is a [`PassError::Pass`]: the region falls back to
+        /// the serial front; else the run stops.
+        pass_failed: bool,
+    },
+    /// The failure of the test hook `ParOptions::fail_part`.
+    #[error("part {part}: the failure injected for the tests (fail_part)")]
+    Injected {
+        /// The part.
+        part: usize,
     },
     /// The region is a thin plate before any pass runs (its volume over
     /// its area is under [`THIN_DEPTH`] mean surface edges): every such
@@ -314,10 +337,18 @@ struct Part {
     stuck: Vec<u32>,
 }
 
-/// `np` empty parts, the input front on part 0 (the reader); pass 1 sends
-/// it out.
-fn seed_parts(np: usize, points: &[P3], point_size: &[f64], faces: &[[u32; 3]]) -> Vec<Part> {
-    let mut parts: Vec<Part> = (0..np).map(|_| Part::default()).collect();
+/// The parts `owned` holds, empty, with the input front on part 0 (the
+/// reader) where it is held here; pass 1 sends it out.
+fn seed_parts(
+    owned: std::ops::Range<usize>,
+    points: &[P3],
+    point_size: &[f64],
+    faces: &[[u32; 3]],
+) -> Vec<Part> {
+    let mut parts: Vec<Part> = owned.clone().map(|_| Part::default()).collect();
+    if owned.start != 0 || owned.is_empty() {
+        return parts;
+    }
     for f in faces {
         let v = f.map(|i| {
             parts[0].local(Rec {
@@ -402,6 +433,37 @@ fn debug_check_parts(parts: &[Part], after: impl std::fmt::Display) {
             }
         }
     }
+}
+
+/// The owned parts' results of one step, once every process knows that
+/// all parts succeeded; else the first failure by part, as its own error
+/// where the part is held and as [`PassError::Remote`] elsewhere (so that
+/// every process stops, or falls back, alike).
+fn agree<C: Comm, T>(
+    comm: &C,
+    pass: u8,
+    local: Vec<Result<T, (usize, FrontError)>>,
+) -> Result<Vec<T>, PassError> {
+    let said: Vec<Option<String>> = comm.all_gather(
+        local
+            .iter()
+            .map(|r| r.as_ref().err().map(|(_, e)| e.to_string()))
+            .collect(),
+    );
+    let Some(part) = said.iter().position(Option::is_some) else {
+        return Ok(local.into_iter().filter_map(Result::ok).collect());
+    };
+    let start = comm.owned().start;
+    if comm.owned().contains(&part) {
+        if let Some(Err((_, source))) = local.into_iter().nth(part - start) {
+            return Err(PassError::Pass { pass, part, source });
+        }
+    }
+    Err(PassError::Remote {
+        part,
+        message: said[part].clone().unwrap_or_default(),
+        pass_failed: true,
+    })
 }
 
 /// What one part's front call gave back, before new points get global ids.
@@ -492,11 +554,6 @@ pub fn mesh_parallel_around<C: Comm>(
     comm: &C,
 ) -> Result<ParOutput, PassError> {
     let np = comm.parts();
-    assert_eq!(
-        comm.owned(),
-        0..np,
-        "the passes hold every part in one process"
-    );
     let depth = ddg_build::depth(points, faces);
     if depth < opts.thin_depth {
         return Err(PassError::Thin { depth });
@@ -525,10 +582,19 @@ pub fn mesh_parallel_around<C: Comm>(
         all = faces.iter().chain(core).copied().collect();
         &all[..]
     };
-    let mut parts = seed_parts(np, points, point_size, faces);
+    let mut parts = seed_parts(comm.owned(), points, point_size, faces);
     let mut next_gid = points.len() as u32;
     if core.is_empty() {
-        rec.st.seeds = seed_inner_parts(&mut parts, &d, &loc, &base, size, &mut next_gid);
+        rec.st.seeds = seed_inner_parts(
+            &mut parts,
+            comm.owned(),
+            (points, faces),
+            &d,
+            &loc,
+            &base,
+            size,
+            &mut next_gid,
+        );
     }
     // §7 step 3, passes 1 to 3 and the crossing passes.
     let mut on = Partitions::new(base);
@@ -568,8 +634,17 @@ pub fn mesh_parallel_around<C: Comm>(
 
     // §8 step 4.
     let t0 = Instant::now();
-    let out = redistribute::run(parts, comm, &loc, &on.base, points, next_gid)?;
-    Ok(rec.finish(out, t0.elapsed().as_secs_f64()))
+    let out = redistribute::run(
+        parts,
+        comm,
+        &loc,
+        &on.base,
+        points,
+        next_gid,
+        opts.fail_part,
+    )?;
+    let held = comm.all_gather(out.pieces.iter().map(|p| p.tets.len()).collect());
+    Ok(rec.finish(out, held, t0.elapsed().as_secs_f64()))
 }
 
 /// The DDG of the front: by `opts.ddg_passes` parallel passes, or by the
@@ -584,7 +659,10 @@ fn the_ddg<C: Comm>(
 ) -> Result<(Ddg, Option<DdgBuildStats>), PassError> {
     if opts.ddg_passes > 0 {
         let (c, passes, cap) = (opts.growth, opts.ddg_passes, opts.ddg_cap);
-        match ddg_build::build_ddg_at(points, faces, depth, c, passes, cap, comm) {
+        // Replicated: every process builds the whole DDG on its own threads
+        // (it is small, and the same bytes everywhere).
+        let local = parafront_comm::Threads::new(comm.parts());
+        match ddg_build::build_ddg_at(points, faces, depth, c, passes, cap, &local) {
             Ok((d, bs)) => return Ok((d, Some(bs))),
             // The serial front gets another go (deterministic: the same
             // failure on any thread count).

@@ -8,7 +8,7 @@ use super::*;
 /// part that owns its three points, and a copy to every part whose region
 /// box it meets (so that each part knows every face bounding its region);
 /// every part advances its faces; new points get global ids. Returns the
-/// tets and the front seconds of each part.
+/// tets and the front seconds of every part (`parts` are the owned ones).
 pub(crate) fn parallel_pass<C: Comm>(
     parts: &mut [Part],
     comm: &C,
@@ -17,7 +17,8 @@ pub(crate) fn parallel_pass<C: Comm>(
     pass: u8,
     next_gid: &mut u32,
 ) -> Result<(Vec<usize>, Vec<f64>), PassError> {
-    let np = parts.len();
+    let np = comm.parts();
+    let start = comm.owned().start;
     let mut boxes = regions.bounds();
     boxes.resize(np, Aabb::EMPTY);
     let boxes: Vec<Aabb> = boxes
@@ -66,12 +67,12 @@ pub(crate) fn parallel_pass<C: Comm>(
     let inboxes = comm.exchange(outboxes);
 
     // Every part meshes inside its region.
-    let made: Vec<Made> = inboxes
+    let made: Vec<Result<Made, (usize, FrontError)>> = inboxes
         .into_par_iter()
         .enumerate()
-        .map(|(k, inbox)| front_call(inbox, k as u32, regions, size))
-        .collect::<Result<_, (usize, FrontError)>>()
-        .map_err(|(part, source)| PassError::Pass { pass, part, source })?;
+        .map(|(i, inbox)| front_call(inbox, (start + i) as u32, regions, size))
+        .collect();
+    let made = crate::agree(comm, pass, made)?;
 
     // Global ids for the new points: an all-gather of the counts.
     let counts = comm.all_gather(
@@ -90,14 +91,14 @@ pub(crate) fn parallel_pass<C: Comm>(
         acc += c;
     }
     *next_gid = acc;
-    let secs: Vec<f64> = made.iter().map(|m| m.seconds).collect();
+    let secs = comm.all_gather(made.iter().map(|m| m.seconds).collect());
     let tets: Vec<usize> = parts
         .par_iter_mut()
         .zip(made)
-        .zip(base)
-        .map(|((part, m), base)| absorb(part, m, base, pass))
+        .zip(&base[start..])
+        .map(|((part, m), &base)| absorb(part, m, base, pass))
         .collect();
-    Ok((tets, secs))
+    Ok((comm.all_gather(tets), secs))
 }
 
 /// Builds one part's front from its inbox (owned faces first, then the
@@ -180,27 +181,33 @@ pub(crate) fn front_call(
 /// pass 2, on one part. Each gets one fine regular tet, inside-out: at the
 /// middle of its DDG tet farthest (in face steps) from its walls, with its
 /// faces facing out as its front. Returns how many parts got one.
+/// Every process decides every part's seed alike (the input is
+/// replicated), so that global ids agree; `parts` are the `owned` ones.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn seed_inner_parts(
     parts: &mut [Part],
+    owned: std::ops::Range<usize>,
+    (points, faces): (&[P3], &[[u32; 3]]),
     d: &Ddg,
     loc: &Locator,
     part0: &[u32],
     size: &(dyn Fn(P3) -> f64 + Sync),
     next_gid: &mut u32,
 ) -> usize {
-    let np = parts.len();
+    let np = part0
+        .iter()
+        .map(|&k| k as usize + 1)
+        .max()
+        .unwrap_or(0)
+        .max(owned.end);
     let nt = d.tets.len();
     // Face steps from a wall or the surface.
     let mut depth = vec![u32::MAX; nt];
     let mut queue = std::collections::VecDeque::new();
-    // Parts that own a face of the input front (held by part 0).
+    // Parts that own a face of the input front.
     let mut owns = vec![false; np];
-    let owner: Vec<Option<u32>> = parts[0]
-        .pts
-        .par_iter()
-        .map(|&p| loc.owner(p, part0))
-        .collect();
-    for f in &parts[0].front {
+    let owner: Vec<Option<u32>> = points.par_iter().map(|&p| loc.owner(p, part0)).collect();
+    for f in faces {
         let o = f.map(|i| owner[i as usize]);
         if let Some(k) = o[0] {
             if o[1] == o[0] && o[2] == o[0] {
@@ -256,18 +263,27 @@ pub(crate) fn seed_inner_parts(
         let Some(v) = ts.iter().find_map(|&t| seed_in(t)) else {
             continue;
         };
-        let part = &mut parts[k];
-        let ids = v.map(|p| {
-            let gid = *next_gid;
+        let gids = v.map(|_| {
             *next_gid += 1;
-            part.local(Rec { gid, p, h: size(p) })
+            *next_gid - 1
+        });
+        seeded += 1;
+        if !owned.contains(&k) {
+            continue;
+        }
+        let part = &mut parts[k - owned.start];
+        let ids = [0, 1, 2, 3].map(|i| {
+            part.local(Rec {
+                gid: gids[i],
+                p: v[i],
+                h: size(v[i]),
+            })
         });
         part.tets.push(ids);
         part.tet_pass.push(1);
         for f in OUTWARD {
             part.front.push(f.map(|i| ids[i]));
         }
-        seeded += 1;
     }
     seeded
 }

@@ -65,11 +65,16 @@ pub(crate) fn run<C: Comm>(
     part0: &[u32],
     input: &[P3],
     n_gid: u32,
+    fail_part: Option<usize>,
 ) -> Result<ParOutput, PassError> {
     // Each tet to the lowest part among its points' DDG hosts.
-    let inbox = comm.exchange(send_tets(parts, loc, part0));
+    let inbox = comm.exchange(send_tets(parts, comm.owned().start, loc, part0));
     // Each part: its points once, by exact key.
-    let mut pieces = receive_tets(inbox)?;
+    let received = receive_tets(inbox).and_then(|p| match fail_part {
+        Some(part) if comm.owned().contains(&part) => Err(PassError::Injected { part }),
+        _ => Ok(p),
+    });
+    let mut pieces = agreed(comm, received)?;
     number_tets(comm, &mut pieces);
     // Send/receive lists: box overlap, then exact keys.
     share_points(comm, &mut pieces);
@@ -77,8 +82,42 @@ pub(crate) fn run<C: Comm>(
     // Global point numbers: the ids still in use, densely (tets removed
     // for pass 4 may have left points behind), input points first.
     let n = number_points(comm, &mut pieces, input.len(), n_gid);
-    // The merged mesh (what part 0 would gather for a single-file output).
-    let (points, tets, tet_pass) = merge(&pieces, input, n)?;
+    // The merged mesh, on part 0's process (the others send their pieces).
+    let (points, tets, tet_pass) = if comm.owned() == (0..comm.parts()) {
+        merge(&pieces, input, n)?
+    } else {
+        let out = pieces
+            .iter()
+            .map(|pc| {
+                let m = (
+                    pc.gid.clone(),
+                    pc.points.clone(),
+                    pc.tets.clone(),
+                    pc.tet_pass.clone(),
+                );
+                vec![(0u32, m)]
+            })
+            .collect();
+        let inbox = comm.exchange(out);
+        if comm.owned().start == 0 && !comm.owned().is_empty() {
+            let got: Vec<Piece> = inbox
+                .into_iter()
+                .next()
+                .unwrap_or_default()
+                .into_iter()
+                .map(|(_, (gid, points, tets, tet_pass))| Piece {
+                    tets,
+                    points,
+                    gid,
+                    tet_pass,
+                    ..Piece::default()
+                })
+                .collect();
+            agreed(comm, merge(&got, input, n))?
+        } else {
+            agreed(comm, Ok((Vec::new(), Vec::new(), Vec::new())))?
+        }
+    };
     Ok(ParOutput {
         points,
         tets,
@@ -88,13 +127,36 @@ pub(crate) fn run<C: Comm>(
     })
 }
 
+/// `r` once every process knows whether each succeeded: an error here
+/// is returned as it is, one elsewhere as [`PassError::Remote`] (a run
+/// stopper: these are no front failures).
+fn agreed<C: Comm, T>(comm: &C, r: Result<T, PassError>) -> Result<T, PassError> {
+    let mine = r.as_ref().err().map(|e| e.to_string());
+    let said: Vec<Option<String>> = comm.all_gather(vec![mine; comm.owned().len()]);
+    match (r, said.iter().position(Option::is_some)) {
+        (Err(e), _) => Err(e),
+        (Ok(x), None) => Ok(x),
+        (Ok(_), Some(part)) => Err(PassError::Remote {
+            part,
+            message: said[part].clone().unwrap_or_default(),
+            pass_failed: false,
+        }),
+    }
+}
+
 /// Each part's tets, addressed to the lowest part among their points' DDG
 /// hosts.
-fn send_tets(parts: Vec<Part>, loc: &Locator, part0: &[u32]) -> Vec<Vec<(u32, TetMsg)>> {
+fn send_tets(
+    parts: Vec<Part>,
+    start: usize,
+    loc: &Locator,
+    part0: &[u32],
+) -> Vec<Vec<(u32, TetMsg)>> {
     parts
         .into_par_iter()
         .enumerate()
-        .map(|(k, part)| {
+        .map(|(i, part)| {
+            let k = start + i;
             let mut host: Vec<Option<u32>> = vec![None; part.pts.len()];
             let mut out = Vec::with_capacity(part.tets.len());
             for (t, tv) in part.tets.iter().enumerate() {
@@ -158,10 +220,11 @@ fn receive_tets(inbox: Vec<Vec<(u32, TetMsg)>>) -> Result<Vec<Keyed>, PassError>
 /// Global tet numbers: by part, then local order.
 fn number_tets<C: Comm>(comm: &C, pieces: &mut [Keyed]) {
     let counts = comm.all_gather(pieces.iter().map(|p| p.0.tets.len() as u32).collect());
-    let mut base = 0u32;
-    for (k, (pc, _)) in pieces.iter_mut().enumerate() {
-        pc.tet_gid = (base..base + counts[k]).collect();
-        base += counts[k];
+    let start = comm.owned().start;
+    let mut base: u32 = counts[..start].iter().sum();
+    for (i, (pc, _)) in pieces.iter_mut().enumerate() {
+        pc.tet_gid = (base..base + counts[start + i]).collect();
+        base += counts[start + i];
     }
 }
 
@@ -181,10 +244,12 @@ fn share_points<C: Comm>(comm: &C, pieces: &mut [Keyed]) {
         .into_iter()
         .map(|[min, max]| Aabb { min, max })
         .collect();
+    let start = comm.owned().start;
     let out: Vec<Vec<(u32, Vec<Key>)>> = pieces
         .par_iter()
         .enumerate()
-        .map(|(k, (pc, _))| {
+        .map(|(i, (pc, _))| {
+            let k = start + i;
             let mut out = Vec::new();
             for (q, b) in boxes.iter().enumerate() {
                 if q == k || b.is_empty() || !b.overlaps(&boxes[k]) {
@@ -208,8 +273,8 @@ fn share_points<C: Comm>(comm: &C, pieces: &mut [Keyed]) {
         .par_iter_mut()
         .zip(inbox)
         .enumerate()
-        .for_each(|(k, ((pc, map), msgs))| {
-            pc.owner = vec![k as u32; pc.points.len()];
+        .for_each(|(i, ((pc, map), msgs))| {
+            pc.owner = vec![(start + i) as u32; pc.points.len()];
             for (q, keys) in msgs {
                 let mut sh: Vec<u32> = keys.iter().filter_map(|x| map.get(x).copied()).collect();
                 if sh.is_empty() {

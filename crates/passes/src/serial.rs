@@ -11,7 +11,7 @@ use super::*;
 /// the whole front go by an exact key to one part, where opposite pairs
 /// cancel. Returns the tets removed.
 pub(super) fn peel_stuck<C: Comm>(parts: &mut [Part], comm: &C) -> usize {
-    let np = parts.len();
+    let np = comm.parts();
     let marked: Vec<Vec<u32>> = parts
         .iter_mut()
         .map(|p| std::mem::take(&mut p.stuck))
@@ -46,7 +46,7 @@ pub(super) fn peel_stuck<C: Comm>(parts: &mut [Part], comm: &C) -> usize {
             (removed, out)
         })
         .collect();
-    let removed = out.iter().map(|o| o.0).sum();
+    let removed = comm.all_reduce(out.iter().map(|o| o.0).collect(), |a, b| a + b);
     let inboxes = comm.exchange(out.into_iter().map(|o| o.1).collect());
     parts.par_iter_mut().zip(inboxes).for_each(|(part, inbox)| {
         let mut hole: Vec<[Rec; 3]> = inbox.into_iter().map(|m| m.1).collect();
@@ -189,6 +189,8 @@ pub(super) fn serial_pass<C: Comm>(
     fill_after: u32,
 ) -> Result<(usize, usize), PassError> {
     let last = rounds.len() - 1;
+    // Part 0's process runs the front; the others follow its choices.
+    let here = comm.owned().start == 0 && !comm.owned().is_empty();
     let out: Vec<Vec<(u32, [Rec; 3])>> = parts
         .iter_mut()
         .map(|p| {
@@ -196,13 +198,13 @@ pub(super) fn serial_pass<C: Comm>(
             faces.iter().map(|f| (0u32, f.map(|i| p.rec(i)))).collect()
         })
         .collect();
-    let mut hole: Vec<[Rec; 3]> = comm
-        .exchange(out)
-        .swap_remove(0)
-        .into_iter()
-        .map(|m| m.1)
-        .collect();
-    if hole.is_empty() {
+    let mut inbox = comm.exchange(out);
+    let mut hole: Vec<[Rec; 3]> = if here {
+        inbox.swap_remove(0).into_iter().map(|m| m.1).collect()
+    } else {
+        Vec::new()
+    };
+    if comm.all_reduce(parts.iter().map(|_| hole.len()).collect(), usize::max) == 0 {
         return Ok((0, 0));
     }
     let mut removed = 0;
@@ -225,73 +227,136 @@ pub(super) fn serial_pass<C: Comm>(
             };
             removed += peel_layer(parts, comm, &mut hole, around.take(), m);
         }
-        let (input, gids) = local_front(hole.iter());
-        let t0 = Instant::now();
-        let res = advance(
-            input,
-            SizeMode::Field(size.field),
-            &Everywhere,
-            &FrontOptions {
-                // Bounded: peeling a layer is the better next step. The first
-                // try removes only its own tets once: recovery's pocket
-                // filling (round 2 on) trips on some left-over fronts.
-                recovery_rounds: rounds[peel],
-                keep_partial: peel < last,
-                max_growth: size.max_growth,
-                fill_after,
-                ..FrontOptions::default()
-            },
+        let step = if here {
+            pass4_try(&hole, size, rounds[peel], peel < last, fill_after)
+        } else {
+            Try4::Elsewhere
+        };
+        // Part 0's choice, for every process: closed (its new points), stuck
+        // again (the older points around what is left) or failed.
+        let said: Vec<(u8, u32, Vec<u32>, String)> = comm.all_gather(
+            (0..parts.len())
+                .map(|i| match (&step, i) {
+                    (Try4::Closed(m), 0) => (0, m.new_points(), Vec::new(), String::new()),
+                    (Try4::Stuck(g), 0) => (1, 0, g.clone(), String::new()),
+                    (Try4::Failed(e), 0) => (2, 0, Vec::new(), e.to_string()),
+                    _ => (3, 0, Vec::new(), String::new()),
+                })
+                .collect(),
         );
-        if tracing::enabled!(tracing::Level::DEBUG) {
-            tracing::debug!(
-                "pass 4: try {peel} on {} faces, {removed} tets peeled so far: {}",
-                hole.len(),
-                if res.is_ok() { "closed" } else { "stuck" }
-            );
-        }
-        let res = match res {
-            Ok(r) => r,
-            Err(FrontError::Stuck { partial, .. }) if peel < last => {
-                // The older points of the faces left: recovery could not
-                // remove the tets of the passes around them.
-                let mut g: Vec<u32> = partial
-                    .iter()
-                    .flat_map(|p| p.front.iter().flatten())
-                    .filter(|&&i| (i as usize) < gids.len())
-                    .map(|&i| gids[i as usize])
-                    .collect();
-                g.sort_unstable();
-                g.dedup();
-                if tracing::enabled!(tracing::Level::DEBUG) {
-                    tracing::debug!(
-                        "pass 4: {} faces left, {} older points",
-                        partial.as_ref().map_or(0, |p| p.front.len()),
-                        g.len()
-                    );
+        let (code, n_new, g, message) = said.into_iter().next().unwrap_or_default();
+        match (code, step) {
+            (0, step) => {
+                if let Try4::Closed(m) = step {
+                    let n = absorb(&mut parts[0], *m, *next_gid, 4);
+                    *next_gid += n_new;
+                    return Ok((n, removed));
                 }
+                *next_gid += n_new;
+                return Ok((0, removed));
+            }
+            (1, _) => {
                 around = (!g.is_empty()).then_some(g);
                 peel += 1;
-                continue;
             }
-            Err(source) => {
+            (_, Try4::Failed(source)) => {
                 return Err(PassError::Pass {
                     pass: 4,
                     part: 0,
                     source,
                 })
             }
-        };
-        let n_new = (res.points.len() - gids.len()) as u32;
-        let m = Made {
+            _ => {
+                return Err(PassError::Remote {
+                    part: 0,
+                    message,
+                    pass_failed: true,
+                })
+            }
+        }
+    }
+}
+
+/// One try of pass 4's front on part 0, and what came of it.
+enum Try4 {
+    Closed(Box<Made>),
+    /// Stuck: the global ids of the older points around what it left.
+    Stuck(Vec<u32>),
+    Failed(FrontError),
+    /// Part 0 is held by another process.
+    Elsewhere,
+}
+
+impl Made {
+    fn new_points(&self) -> u32 {
+        self.res
+            .as_ref()
+            .map_or(0, |r| (r.points.len() - self.input_gid.len()) as u32)
+    }
+}
+
+/// Pass 4's front on `hole` with `rounds` of recovery; `retry`: a stuck
+/// front gives back the points around what it left instead of an error.
+fn pass4_try(
+    hole: &[[Rec; 3]],
+    size: Sizes<'_>,
+    rounds: u32,
+    retry: bool,
+    fill_after: u32,
+) -> Try4 {
+    let (input, gids) = local_front(hole.iter());
+    let t0 = Instant::now();
+    let res = advance(
+        input,
+        SizeMode::Field(size.field),
+        &Everywhere,
+        &FrontOptions {
+            // Bounded: peeling a layer is the better next step. The first
+            // try removes only its own tets once: recovery's pocket
+            // filling (round 2 on) trips on some left-over fronts.
+            recovery_rounds: rounds,
+            keep_partial: retry,
+            max_growth: size.max_growth,
+            fill_after,
+            ..FrontOptions::default()
+        },
+    );
+    if tracing::enabled!(tracing::Level::DEBUG) {
+        tracing::debug!(
+            "pass 4: a try on {} faces: {}",
+            hole.len(),
+            if res.is_ok() { "closed" } else { "stuck" }
+        );
+    }
+    match res {
+        Ok(r) => Try4::Closed(Box::new(Made {
             stuck: Vec::new(),
             input_ok: vec![true; gids.len()],
             input_gid: gids,
-            res: Some(res),
+            res: Some(r),
             seconds: t0.elapsed().as_secs_f64(),
-        };
-        let n = absorb(&mut parts[0], m, *next_gid, 4);
-        *next_gid += n_new;
-        return Ok((n, removed));
+        })),
+        Err(FrontError::Stuck { partial, .. }) if retry => {
+            // The older points of the faces left: recovery could not
+            // remove the tets of the passes around them.
+            let mut g: Vec<u32> = partial
+                .iter()
+                .flat_map(|p| p.front.iter().flatten())
+                .filter(|&&i| (i as usize) < gids.len())
+                .map(|&i| gids[i as usize])
+                .collect();
+            g.sort_unstable();
+            g.dedup();
+            if tracing::enabled!(tracing::Level::DEBUG) {
+                tracing::debug!(
+                    "pass 4: {} faces left, {} older points",
+                    partial.as_ref().map_or(0, |p| p.front.len()),
+                    g.len()
+                );
+            }
+            Try4::Stuck(g)
+        }
+        Err(e) => Try4::Failed(e),
     }
 }
 
@@ -322,8 +387,14 @@ pub(super) fn peel_layer<C: Comm>(
             faces.into_iter().map(|v| (0u32, v)).collect()
         })
         .collect();
-    let inbox = comm.exchange(out).swap_remove(0);
-    let removed = inbox.len() / 4;
+    let mut inbox = comm.exchange(out);
+    let here = comm.owned().start == 0 && !comm.owned().is_empty();
+    let inbox = if here {
+        inbox.swap_remove(0)
+    } else {
+        Vec::new()
+    };
+    let removed = comm.all_reduce(parts.iter().map(|_| inbox.len() / 4).collect(), usize::max);
     hole.extend(inbox.into_iter().map(|m| m.1));
     cancel_pairs(hole);
     removed

@@ -13,6 +13,7 @@ pub use parafront_ddg::Partition;
 pub use regions::{material_regions, RegionFront};
 pub use summary::{Stage, Summary};
 
+use parafront_comm::Comm;
 use parafront_ddg::DdgError;
 use parafront_front::{advance, FrontError, FrontInput, FrontOptions, SizeMode};
 use parafront_lattice::{Lattice, LatticeOptions};
@@ -103,6 +104,11 @@ pub struct MeshOptions {
     /// of a part's width.
     #[serde(default = "default_ddg_cap")]
     pub ddg_cap: f64,
+    /// Test hook (the MPI tests' failing rank): redistribution fails on
+    /// this part, and every process must stop with its message. None by
+    /// default.
+    #[serde(default)]
+    pub fail_part: Option<usize>,
 }
 
 fn default_thin_depth() -> f64 {
@@ -146,6 +152,7 @@ impl Default for MeshOptions {
             thin_depth: default_thin_depth(),
             serial_from: default_serial_from(),
             ddg_cap: default_ddg_cap(),
+            fail_part: None,
         }
     }
 }
@@ -241,16 +248,35 @@ pub enum MeshError {
 /// `check_against_surface` unless `no_check`. Runs on `opts.threads`
 /// threads (a pool of its own when that differs from the current one).
 pub fn mesh_surface(s: &Surface, opts: &MeshOptions) -> Result<(TetMesh, Summary), MeshError> {
+    let comm = parafront_comm::Threads::new(opts.parts.max(1));
+    mesh_surface_on(s, opts, &comm).map(|r| r.expect("one process holds every part"))
+}
+
+/// [`mesh_surface`] with the parts' messages going through `comm`, which
+/// spreads `opts.parts` over processes (MPI): every process reads the
+/// surface and builds the size field and the DDG (they are small), the
+/// passes run on the parts each holds, and the mesh gathers on the process
+/// of part 0, which improves and checks it and gets `Some`; the others get
+/// `None` once the passes are done.
+pub fn mesh_surface_on<C: Comm>(
+    s: &Surface,
+    opts: &MeshOptions,
+    comm: &C,
+) -> Result<Option<(TetMesh, Summary)>, MeshError> {
     let t = opts.threads;
     if t > 0 && t != rayon::current_num_threads() {
         if let Ok(pool) = rayon::ThreadPoolBuilder::new().num_threads(t).build() {
-            return pool.install(|| mesh_surface_here(s, opts));
+            return pool.install(|| mesh_surface_here(s, opts, comm));
         }
     }
-    mesh_surface_here(s, opts)
+    mesh_surface_here(s, opts, comm)
 }
 
-fn mesh_surface_here(s: &Surface, opts: &MeshOptions) -> Result<(TetMesh, Summary), MeshError> {
+fn mesh_surface_here<C: Comm>(
+    s: &Surface,
+    opts: &MeshOptions,
+    comm: &C,
+) -> Result<Option<(TetMesh, Summary)>, MeshError> {
     let mut sum = Summary {
         threads: rayon::current_num_threads(),
         ..Summary::default()
@@ -298,15 +324,20 @@ fn mesh_surface_here(s: &Surface, opts: &MeshOptions) -> Result<(TetMesh, Summar
     let t0 = Instant::now();
     let mut mesh = surface_mesh(s);
     let lattice_inner = if opts.parts > 1 {
-        mesh_parts(
+        let inner = mesh_parts(
             s,
             &fronts,
             &sizing,
             opts,
             &mut mesh,
             &mut sum,
+            comm,
             mesh_parallel_around,
-        )?
+        )?;
+        if !holds_part0(comm) {
+            return Ok(None);
+        }
+        inner
     } else {
         let lat0 = sum.seconds(Stage::Lattice);
         let inner = mesh_serial(s, &fronts, &sizing, opts, &mut mesh, &mut sum)?;
@@ -359,7 +390,12 @@ fn mesh_surface_here(s: &Surface, opts: &MeshOptions) -> Result<(TetMesh, Summar
     sum.tets = mesh.tets.len();
     sum.points = mesh.points.len();
     sum.regions = fronts.len();
-    Ok((mesh, sum))
+    Ok(Some((mesh, sum)))
+}
+
+/// This process holds part 0, where the mesh gathers.
+fn holds_part0<C: Comm>(comm: &C) -> bool {
+    comm.owned().start == 0 && !comm.owned().is_empty()
 }
 
 /// The inner bodies that are meshed as voids without `regions`: shells
@@ -587,17 +623,21 @@ fn append_region(
 }
 
 /// The parallel mesher (§5 to §8, `parallel`: `mesh_parallel`, or one
-/// that fails in tests) on each region, on the threads backend; the
-/// merged result goes into `mesh` like the serial front's.
-fn mesh_parts(
+/// that fails in tests) on each region, its parts' messages through
+/// `comm`; the merged result goes into `mesh` like the serial front's, on
+/// the process of part 0 (the others leave `mesh` as it is).
+#[allow(clippy::too_many_arguments)]
+fn mesh_parts<C: Comm>(
     s: &Surface,
     fronts: &[RegionFront],
     sizing: &Sizing,
     opts: &MeshOptions,
     mesh: &mut TetMesh,
     sum: &mut Summary,
-    parallel: ParallelMesher,
+    comm: &C,
+    parallel: ParallelMesher<C>,
 ) -> Result<Vec<u32>, MeshError> {
+    let holds = holds_part0(comm);
     // The lattice's inner points, for improvement to leave alone.
     let mut lattice_inner = Vec::new();
     let field = |p| sizing.size(p);
@@ -616,9 +656,9 @@ fn mesh_parts(
         thin_depth: opts.thin_depth,
         serial_from: opts.serial_from,
         ddg_cap: opts.ddg_cap,
+        fail_part: opts.fail_part,
         ..ParOptions::default()
     };
-    let comm = parafront_comm::Threads::new(opts.parts);
     // Seconds of each of `Stage::PARALLEL`, summed over the regions.
     let mut stage = [0.0f64; Stage::PARALLEL.len()];
     for rf in fronts {
@@ -631,7 +671,7 @@ fn mesh_parts(
         hs.extend_from_slice(&lattice.size);
         let core: Vec<[u32; 3]> = lattice.faces.iter().map(|f| f.map(|v| v + n_in)).collect();
         let t_par = Instant::now();
-        let out = match parallel(&pts, &hs, &rf.faces, &core, &field, &popts, &comm) {
+        let out = match parallel(&pts, &hs, &rf.faces, &core, &field, &popts, comm) {
             Ok(out) => out,
             // A valid surface must not fail (AF5, step 4): a front the
             // passes leave unclosable (CAD needles next to a part wall) gets
@@ -639,6 +679,9 @@ fn mesh_parts(
             // does a thin part whose passes leave most of it to pass 4.
             Err(
                 e @ (PassError::Pass { .. }
+                | PassError::Remote {
+                    pass_failed: true, ..
+                }
                 | PassError::Unsuited { .. }
                 | PassError::Thin { .. }
                 | PassError::Ddg(DdgError::Front(_))),
@@ -650,6 +693,9 @@ fn mesh_parts(
                 sum.serial_fallback
                     .push((rf.region_id as usize, e.to_string()));
                 sum.push(Stage::PassesGivenUp, t_par.elapsed().as_secs_f64());
+                if !holds {
+                    continue; // the serial front runs where the mesh gathers
+                }
                 let t0 = Instant::now();
                 let lat0 = sum.seconds(Stage::Lattice);
                 serial_region(s, rf, sizing, opts, mesh, sum, &mut lattice_inner)?;
@@ -664,6 +710,10 @@ fn mesh_parts(
                 })
             }
         };
+        if !holds {
+            sum.parallel.push(out.stats);
+            continue;
+        }
         let mut tets = out.tets;
         tets.extend(lattice.tets.iter().map(|t| t.map(|v| v + n_in)));
         let base = append_region(mesh, rf, &out.points, &tets);
@@ -704,14 +754,14 @@ fn mesh_parts(
     Ok(lattice_inner)
 }
 
-type ParallelMesher = fn(
+type ParallelMesher<C> = fn(
     &[parafront_geom::P3],
     &[f64],
     &[[u32; 3]],
     &[[u32; 3]],
     &(dyn Fn(parafront_geom::P3) -> f64 + Sync),
     &ParOptions,
-    &parafront_comm::Threads,
+    &C,
 ) -> Result<ParOutput, PassError>;
 
 #[cfg(test)]
@@ -756,7 +806,11 @@ mod tests {
         let sizing = Sizing::build(&s, &opts.size, None).unwrap();
         let mut mesh = surface_mesh(&s);
         let mut sum = Summary::default();
-        mesh_parts(&s, &fronts, &sizing, &opts, &mut mesh, &mut sum, stuck).unwrap();
+        let comm = parafront_comm::Threads::new(opts.parts);
+        mesh_parts(
+            &s, &fronts, &sizing, &opts, &mut mesh, &mut sum, &comm, stuck,
+        )
+        .unwrap();
         assert_eq!(sum.serial_fallback.len(), 1);
         assert_eq!(sum.serial_fallback[0].0, 1);
         assert!(sum.serial_fallback[0].1.contains("pass 4"));
