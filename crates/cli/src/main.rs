@@ -299,9 +299,17 @@ fn main() -> ExitCode {
                     .map(|s| (s, surface.display().to_string()));
                 mpi_run::run_mesh(m, input, &output, &mesh, &write)
             }
+            Cmd::Bench {
+                surface,
+                size,
+                parts,
+                threads,
+                ddg_passes,
+                ..
+            } => mpi_run::run_bench(m, &surface, size, &parts, &threads, ddg_passes),
             _ => Err(Fail(
                 2,
-                "under mpirun, only `mesh` and `demo` run (over the ranks)".into(),
+                "under mpirun, only `mesh`, `demo` and `bench` run (over the ranks)".into(),
             )),
         };
         return exit(res);

@@ -71,3 +71,98 @@ pub(crate) fn run_mesh(
     };
     crate::run_mesh_on(&s, &name, out, a, w, &*mpi, rank == 0).map_err(quiet)
 }
+
+/// `mpirun -n R parafront bench`: every (parts, threads) pair over the R
+/// ranks, generation only (as in the paper's tables); rank 0 prints each
+/// row with nproc = R, nprol = threads per rank, ncore = R x threads, the
+/// wall time of the slowest rank and the CPU time of all.
+pub(crate) fn run_bench(
+    mpi: &mut Mpi,
+    path: &Path,
+    size: Option<f64>,
+    parts: &[usize],
+    threads: &[usize],
+    ddg_passes: Option<usize>,
+) -> Result<(), Fail> {
+    let (rank, ranks) = (mpi.rank(), mpi.ranks());
+    let quiet = |f: Fail| {
+        if rank == 0 {
+            f
+        } else {
+            Fail(f.0, String::new())
+        }
+    };
+    if let Some(&p) = parts.iter().find(|&&p| p < ranks) {
+        return Err(quiet(Fail(
+            2,
+            format!("--parts {p} under {ranks} MPI ranks: give every rank a part"),
+        )));
+    }
+    let input = parafront_surface::read::read_surface(path).map_err(Fail::from);
+    mpi.set_parts(parts[0].max(1));
+    let any = mpi.all_reduce(vec![input.is_err() as u8; mpi.owned().len()], u8::max);
+    let s = match input {
+        Err(e) => return Err(quiet(e)),
+        Ok(_) if any > 0 => {
+            return Err(quiet(Fail(
+                1,
+                "another MPI rank could not read the surface".into(),
+            )))
+        }
+        Ok(s) => s,
+    };
+    if rank == 0 {
+        println!(
+            "{}: {} points, {} triangles ({ranks} MPI ranks)",
+            path.display(),
+            s.points.len(),
+            s.tris.len()
+        );
+        crate::parallel::print_bench_head();
+    }
+    for &p in parts {
+        mpi.set_parts(p);
+        if rank == 0 {
+            println!("--parts {p}:");
+        }
+        for &t in threads {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(t.max(1))
+                .build()
+                .map_err(|e| quiet(Fail(2, e.to_string())))?;
+            let mut o = parafront_pipeline::MeshOptions {
+                parts: p,
+                threads: t,
+                optimize: 0,
+                no_quality: true,
+                ddg_passes,
+                ..Default::default()
+            };
+            o.size.h = size;
+            mpi.barrier();
+            let t0 = std::time::Instant::now();
+            let cpu0 = parafront_pipeline::process_cpu_seconds();
+            let res = pool.install(|| parafront_pipeline::mesh_surface_on(&s, &o, &*mpi));
+            let secs = t0.elapsed().as_secs_f64();
+            let cpu = parafront_pipeline::process_cpu_seconds()
+                .zip(cpu0)
+                .map_or(0.0, |(a, b)| a - b);
+            let res = res.map_err(|e| quiet(Fail(1, format!("parts {p}, threads {t}: {e}"))))?;
+            let n = mpi.owned().len();
+            let secs = mpi.all_reduce(vec![secs; n], f64::max);
+            let cpu = mpi.all_reduce(
+                (0..n).map(|i| if i == 0 { cpu } else { 0.0 }).collect(),
+                |a, b| a + b,
+            );
+            if let Some((m, sum)) = res {
+                let t = t.max(1);
+                crate::parallel::print_row((ranks, t, ranks * t), m.tets.len(), secs, cpu, &sum);
+            }
+        }
+    }
+    if rank == 0 {
+        crate::parallel::print_bench_notes();
+        println!("nproc: MPI ranks, nprol: threads per rank, ncore: both; CPU s: the slowest rank's wall time, cpu s: all ranks' CPU.");
+    }
+    Ok(())
+}

@@ -158,16 +158,39 @@ pub fn write_partitioned(path: &Path, sum: &Summary, w: &WriteOptions) -> Result
     Ok(())
 }
 
+/// `parafront bench`'s table head.
+pub(crate) fn print_bench_head() {
+    println!(
+        "{:>5} {:>5} {:>5} {:>9} {:>9} {:>11} {:>11} | {:>7} {:>7} {:>7} {:>7} {:>7} {:>7} | {:>6} {:>6} {:>6} {:>6} | {:>6} {:>6} {:>8} | {:>5} {:>6} {:>8} {:>4} {:>7} | {:>8} {:>6} {:>6}",
+        "nproc", "nprol", "ncore", "nelem", "CPU s", "AbsSpeed", "RelSpeed",
+        "ddg", "part", "pass1", "pass2", "pass3", "pass4",
+        "%p1", "%p2", "%p3", "%p4", "imbP", "imbH", "crit s",
+        "split", "cut", "cutF", "pcs", "split s", "cpu s", "%ddgW", "%ddgC"
+    );
+}
+
 /// One row of `parafront bench`'s table: `n` tets made by `p` parts on
-/// `t` threads in `secs` (wall) and `cpu` seconds.
+/// `t` threads in `secs` (wall) and `cpu` seconds; nproc is the parts,
+/// nprol the threads per part, ncore the threads.
 fn print_bench_row(p: usize, t: usize, n: usize, secs: f64, cpu: f64, sum: &Summary) {
+    let cores = t.max(1);
+    let nprol = (cores / p.max(1)).max(1);
+    print_row((p, nprol, cores), n, secs, cpu, sum);
+}
+
+/// A row of the table for `(nproc, nprol, ncore)`.
+pub(crate) fn print_row(
+    (p, nprol, cores): (usize, usize, usize),
+    n: usize,
+    secs: f64,
+    cpu: f64,
+    sum: &Summary,
+) {
     let ddg_cpu: f64 = sum
         .parallel
         .iter()
         .map(|x| x.ddg_cpu_seconds + x.partition_cpu_seconds)
         .sum();
-    let cores = t.max(1);
-    let nprol = (cores / p.max(1)).max(1);
     let st = sum.parallel.first();
     let share = |k: usize| {
         st.map_or(if k == 0 { 100.0 } else { 0.0 }, |_| {
@@ -236,13 +259,7 @@ pub fn run_bench(
         s.points.len(),
         s.tris.len()
     );
-    println!(
-        "{:>5} {:>5} {:>5} {:>9} {:>9} {:>11} {:>11} | {:>7} {:>7} {:>7} {:>7} {:>7} {:>7} | {:>6} {:>6} {:>6} {:>6} | {:>6} {:>6} {:>8} | {:>5} {:>6} {:>8} {:>4} {:>7} | {:>8} {:>6} {:>6}",
-        "nproc", "nprol", "ncore", "nelem", "CPU s", "AbsSpeed", "RelSpeed",
-        "ddg", "part", "pass1", "pass2", "pass3", "pass4",
-        "%p1", "%p2", "%p3", "%p4", "imbP", "imbH", "crit s",
-        "split", "cut", "cutF", "pcs", "split s", "cpu s", "%ddgW", "%ddgC"
-    );
+    print_bench_head();
     for &p in parts {
         // P = 1 is the serial front: no partition, one row.
         let methods = if p > 1 { methods } else { &methods[..1] };
@@ -281,6 +298,12 @@ pub fn run_bench(
             }
         }
     }
+    print_bench_notes();
+    Ok(())
+}
+
+/// What the table's columns mean.
+pub(crate) fn print_bench_notes() {
     println!(
         "imbP: predicted (DDG weights), imbH: tets held after redistribution (max/mean, region 1);"
     );
@@ -293,5 +316,4 @@ pub fn run_bench(
     println!(
         "cpu s: CPU seconds of the run, all threads; %ddgW, %ddgC: the DDG and its partition's share of the wall time and of the CPU time."
     );
-    Ok(())
 }

@@ -144,6 +144,39 @@ fn two_and_four_ranks_give_the_threads_mesh() {
 }
 
 #[test]
+fn bench_under_mpirun_gives_the_papers_table() {
+    if mpirun().is_none() {
+        eprintln!("skipping: mpirun not found");
+        return;
+    }
+    let torus = write(
+        "bench_torus.obj",
+        &generate::torus([0.0; 3], 2.0, 0.7, 40, 20),
+    );
+    let t = torus.to_str().unwrap();
+    let args = ["bench", t, "--parts", "4", "--threads", "1,2"];
+    let limit = Duration::from_secs(300);
+    let one = run(0, &args, limit);
+    assert!(one.ok, "{}", one.err);
+    let r = run(2, &args, limit);
+    assert!(r.ok, "{}", r.err);
+    // Rows: nproc nprol ncore nelem ...; the tets are the threads run's.
+    let rows = |out: &str| -> Vec<Vec<String>> {
+        out.lines()
+            .map(|l| l.split_whitespace().map(String::from).collect::<Vec<_>>())
+            .filter(|w| w.len() > 4 && w[..4].iter().all(|x| x.parse::<usize>().is_ok()))
+            .collect()
+    };
+    let (a, b) = (rows(&one.out), rows(&r.out));
+    assert_eq!(b.len(), 2, "{}", r.out);
+    assert_eq!(a.len(), 2, "{}", one.out);
+    for (row, want) in b.iter().zip([["2", "1", "2"], ["2", "2", "4"]]) {
+        assert_eq!(&row[..3], &want, "{}", r.out);
+        assert_eq!(row[3], a[0][3], "tets differ: {}\n{}", r.out, one.out);
+    }
+}
+
+#[test]
 fn a_corpus_part_on_ranks_is_the_threads_mesh() {
     let (Some(_), Some(g)) = (mpirun(), std::env::var_os("PARAFRONT_GEOMETRY")) else {
         eprintln!("skipping: mpirun or PARAFRONT_GEOMETRY missing");
