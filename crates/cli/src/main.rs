@@ -470,11 +470,25 @@ pub(crate) fn run_mesh_on<C: Comm>(
 ) -> Result<(), Fail> {
     let mut opts = mesh_options(a)?;
     let wopts = write_options(w, Some(s))?;
-    if parafront_io::Format::from_path(out).is_none() {
+    // A .pvtu output keeps the mesh in its pieces (under MPI, each process
+    // writes its own): no merged mesh.
+    let pieces_out = out.extension().and_then(|e| e.to_str()) == Some("pvtu");
+    if pieces_out {
+        if a.pvtu.is_some() {
+            return Err(Fail(2, "-o is a .pvtu already: leave out --pvtu".into()));
+        }
+        if opts.optimize > 0 {
+            return Err(Fail(
+                2,
+                "-o .pvtu writes the mesh as the parallel passes left it: add --optimize 0".into(),
+            ));
+        }
+        opts.gather = false;
+    } else if parafront_io::Format::from_path(out).is_none() {
         return Err(Fail(
             2,
             format!(
-                "{}: unknown output format (use .vtu, .msh or .mesh)",
+                "{}: unknown output format (use .vtu, .pvtu, .msh or .mesh)",
                 out.display()
             ),
         ));
@@ -513,6 +527,9 @@ pub(crate) fn run_mesh_on<C: Comm>(
             return Err(Fail(1, format!("{name}: {e}{hint}")));
         }
     };
+    if pieces_out {
+        return write_pieces(out, &mut sum, &wopts, comm, lead);
+    }
     let t0 = Instant::now();
     write_mesh(out, &mesh, &wopts)?;
     sum.push(Stage::Write, t0.elapsed().as_secs_f64());
@@ -527,6 +544,55 @@ pub(crate) fn run_mesh_on<C: Comm>(
         plot::plot_histograms(q, sum.quality_before.as_ref(), p)?;
         println!("wrote {}", p.display());
     }
+    Ok(())
+}
+
+/// `-o x.pvtu`: every process writes its pieces (the one holding part 0
+/// the index too); when any fails, every process removes what it wrote.
+/// The `lead` prints the summary, with each process's peak memory.
+fn write_pieces<C: Comm>(
+    out: &Path,
+    sum: &mut Summary,
+    w: &WriteOptions,
+    comm: &C,
+    lead: bool,
+) -> Result<(), Fail> {
+    let t0 = Instant::now();
+    let held = comm.owned();
+    let n = held.len();
+    let res = parallel::write_partitioned_share(out, sum, w, held);
+    let failed = comm.all_reduce(vec![res.is_err() as u8; n], u8::max);
+    let files = match res {
+        Err(e) => return Err(e),
+        Ok(files) if failed > 0 => {
+            for f in &files {
+                let _ = std::fs::remove_file(f);
+            }
+            return Err(Fail(1, "another process could not write its pieces".into()));
+        }
+        Ok(files) => files,
+    };
+    sum.push(Stage::Write, t0.elapsed().as_secs_f64());
+    let peaks = comm.all_gather(vec![peak_memory_bytes().unwrap_or(0); n]);
+    if lead {
+        print_summary(sum);
+        parallel::print_parallel(sum);
+        if peaks.len() > 1 && peaks.iter().any(|&p| p != peaks[0]) {
+            // One value per part: a process's repeats for each part it holds.
+            let mut per: Vec<u64> = peaks.clone();
+            per.dedup();
+            println!(
+                "peak memory per process: {} MiB",
+                per.iter()
+                    .map(|&b| format!("{:.1}", b as f64 / 1048576.0))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            );
+        }
+        let total = sum.parallel.first().map_or(0, |st| st.parts) * sum.parallel.len();
+        println!("wrote {} ({total} pieces)", out.display());
+    }
+    drop(files);
     Ok(())
 }
 

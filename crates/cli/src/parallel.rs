@@ -1,6 +1,6 @@
 //! The parallel mesher's report, its partitioned output and `bench`.
 use crate::Fail;
-use parafront_io::{write_pvtu, Field, FieldData, Piece, WriteOptions};
+use parafront_io::{write_pvtu_share, Field, FieldData, Piece, WriteOptions};
 use parafront_mesh::{PointId, TetMesh};
 use parafront_pipeline::{Stage, Summary};
 use std::path::Path;
@@ -83,7 +83,19 @@ pub fn print_parallel(sum: &Summary) {
 /// point and cell ids, the owning part of each point, a ghost flag on the
 /// points another part owns, and the number of parts sharing each point.
 pub fn write_partitioned(path: &Path, sum: &Summary, w: &WriteOptions) -> Result<(), Fail> {
-    if sum.pieces.is_empty() {
+    let parts = sum.parallel.first().map_or(0, |st| st.parts);
+    write_partitioned_share(path, sum, w, 0..parts).map(|_| ())
+}
+
+/// [`write_partitioned`] for the parts `held` of this process (MPI): its
+/// pieces, and the index where part 0 is held. Returns the files written.
+pub(crate) fn write_partitioned_share(
+    path: &Path,
+    sum: &Summary,
+    w: &WriteOptions,
+    held: std::ops::Range<usize>,
+) -> Result<Vec<std::path::PathBuf>, Fail> {
+    if sum.pieces.is_empty() && held.start == 0 {
         return Err(Fail(2, "--pvtu needs --parts > 1".into()));
     }
     if let Some((r, _)) = sum.serial_fallback.first() {
@@ -104,13 +116,16 @@ pub fn write_partitioned(path: &Path, sum: &Summary, w: &WriteOptions) -> Result
     // Pieces come region by region, `parts` per region; global cell ids
     // are per region, so each region starts after the ones before it.
     let parts = sum.parallel[0].parts;
+    let n_held = held.len().max(1);
+    let mut ids = Vec::with_capacity(sum.pieces.len());
     let mut region_base = vec![0i64; sum.parallel.len() + 1];
     for (r, st) in sum.parallel.iter().enumerate() {
         region_base[r + 1] = region_base[r] + st.pass_tets.iter().sum::<usize>() as i64;
     }
     let mut arrays = Vec::with_capacity(sum.pieces.len());
     for (i, pc) in sum.pieces.iter().enumerate() {
-        let (r, k) = (i / parts, i % parts);
+        let (r, k) = (i / n_held, held.start + i % n_held);
+        ids.push(r * parts + k);
         let cell_base = region_base[r];
         let mut sharers = vec![0i32; pc.points.len()];
         for list in &pc.shared {
@@ -154,8 +169,13 @@ pub fn write_partitioned(path: &Path, sum: &Summary, w: &WriteOptions) -> Result
             ],
         })
         .collect();
-    write_pvtu(path, &pieces, w)?;
-    Ok(())
+    let index = held.start == 0 && !held.is_empty();
+    let total = parts * sum.parallel.len();
+    let mut written = write_pvtu_share(path, &ids, total, index, &pieces, w)?;
+    if index {
+        written.push(path.to_path_buf());
+    }
+    Ok(written)
 }
 
 /// `parafront bench`'s table head.

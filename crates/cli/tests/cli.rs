@@ -336,6 +336,66 @@ fn parts_write_a_partitioned_mesh() {
     assert_eq!(total, m.tets.len(), "{pvtu}");
 }
 
+/// `-o x.pvtu`: the mesh stays in its pieces (no merged mesh; under MPI
+/// each process writes its own). They hold the tets the summary gives,
+/// which are the tets of the merged run; improvement must be off.
+#[test]
+fn a_pvtu_output_keeps_the_pieces() {
+    let pv = tmp("demo_pieces.pvtu");
+    let o = bin()
+        .args(["demo", "--parts", "4", "-o"])
+        .arg(&pv)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("--optimize 0"));
+    assert!(!pv.exists());
+    let o = bin()
+        .args(["demo", "--parts", "4", "--optimize", "0", "-o"])
+        .arg(&pv)
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&o.stdout).to_string();
+    assert!(
+        o.status.success(),
+        "{text}{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let said: usize = text
+        .lines()
+        .find_map(|l| l.strip_suffix(" regions"))
+        .and_then(|l| l.split(' ').next())
+        .and_then(|n| n.parse().ok())
+        .expect("the tet count");
+    let pvtu = std::fs::read_to_string(&pv).unwrap();
+    let names: Vec<&str> = pvtu
+        .split("Source=\"")
+        .skip(1)
+        .map(|s| s.split('"').next().unwrap())
+        .collect();
+    // Two regions on four parts.
+    assert_eq!(names.len(), 8, "{pvtu}");
+    let total: usize = names
+        .iter()
+        .map(|n| {
+            parafront_io::read_mesh(&pv.parent().unwrap().join(n))
+                .unwrap()
+                .tets
+                .len()
+        })
+        .sum();
+    assert_eq!(total, said);
+    // The merged run makes the same tets.
+    let vol = tmp("demo_merged.vtu");
+    let o = bin()
+        .args(["demo", "--parts", "4", "--optimize", "0", "-o"])
+        .arg(&vol)
+        .output()
+        .unwrap();
+    assert!(o.status.success());
+    assert_eq!(parafront_io::read_mesh(&vol).unwrap().tets.len(), said);
+}
+
 /// An extreme needle (a 6-sided frustum, triangles 2500 times longer than
 /// its tip is wide) that the front alone cannot close: the constrained fill
 /// closes it (issue 20), the mesh is valid, and the summary says so.

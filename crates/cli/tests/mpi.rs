@@ -144,6 +144,76 @@ fn two_and_four_ranks_give_the_threads_mesh() {
 }
 
 #[test]
+fn every_rank_writes_its_pieces_of_a_pvtu() {
+    if mpirun().is_none() {
+        eprintln!("skipping: mpirun not found");
+        return;
+    }
+    let limit = Duration::from_secs(300);
+    let dir = |tag: &str| {
+        let d = tmp(tag);
+        std::fs::create_dir_all(&d).unwrap();
+        d
+    };
+    let args = [
+        "demo",
+        "--parts",
+        "8",
+        "--optimize",
+        "0",
+        "--no-compress",
+        "-o",
+    ];
+    let one = dir("pvtu_threads").join("demo.pvtu");
+    let base = run(0, &[&args[..], &[one.to_str().unwrap()]].concat(), limit);
+    assert!(base.ok, "{}", base.err);
+    let n = tets_said(&base.out);
+    let files = |p: &Path| -> Vec<(String, Vec<u8>)> {
+        let mut v: Vec<(String, Vec<u8>)> = std::fs::read_dir(p.parent().unwrap())
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .map(|f| {
+                (
+                    f.file_name().unwrap().to_string_lossy().into(),
+                    std::fs::read(&f).unwrap(),
+                )
+            })
+            .collect();
+        v.sort();
+        v
+    };
+    let want = files(&one);
+    // The index and 2 regions x 8 pieces; together the summary's tets.
+    assert_eq!(want.len(), 17);
+    let total: usize = want
+        .iter()
+        .filter(|(name, _)| name.ends_with(".vtu"))
+        .map(|(name, _)| read_mesh(&one.with_file_name(name)).unwrap().tets.len())
+        .sum();
+    assert_eq!(total, n);
+    for ranks in [2, 4] {
+        let many = dir(&format!("pvtu_{ranks}")).join("demo.pvtu");
+        let r = run(
+            ranks,
+            &[&args[..], &[many.to_str().unwrap()]].concat(),
+            limit,
+        );
+        assert!(r.ok, "{ranks} ranks: {}", r.err);
+        assert_eq!(tets_said(&r.out), n);
+        assert!(r.out.contains("peak memory per process"), "{}", r.out);
+        let got = files(&many);
+        assert_eq!(got.len(), want.len());
+        for (a, b) in want.iter().zip(&got) {
+            assert!(
+                a == b,
+                "{ranks} ranks: {} differs from the threads run's",
+                b.0
+            );
+        }
+    }
+}
+
+#[test]
 fn bench_under_mpirun_gives_the_papers_table() {
     if mpirun().is_none() {
         eprintln!("skipping: mpirun not found");

@@ -29,7 +29,7 @@ mod vtu_read;
 pub use atomic::write_atomic;
 pub use read::read_mesh;
 pub use surface::{surface_format, write_surface, SurfaceFormat};
-pub use vtu::{write_pvtu, write_vtu, Field, FieldData, Piece};
+pub use vtu::{write_pvtu, write_pvtu_share, write_vtu, Field, FieldData, Piece};
 
 use parafront_mesh::TetMesh;
 use std::path::{Path, PathBuf};

@@ -511,6 +511,23 @@ pub fn write_pvtu(
     parts: &[Piece],
     opts: &WriteOptions,
 ) -> Result<Vec<PathBuf>, IoError> {
+    let ids: Vec<usize> = (0..parts.len()).collect();
+    write_pvtu_share(path, &ids, parts.len(), true, parts, opts)
+}
+
+/// [`write_pvtu`] for one process's share of a partitioned mesh (MPI):
+/// `parts[i]` is written as `<stem>_<ids[i]>.vtu`; with `index`, the index
+/// at `path` names all `total` pieces (the other processes' pieces carry
+/// the same arrays). Returns the parts' paths; on error no file of this
+/// call remains.
+pub fn write_pvtu_share(
+    path: &Path,
+    ids: &[usize],
+    total: usize,
+    index: bool,
+    parts: &[Piece],
+    opts: &WriteOptions,
+) -> Result<Vec<PathBuf>, IoError> {
     let stem = path
         .file_stem()
         .and_then(|s| s.to_str())
@@ -526,7 +543,7 @@ pub fn write_pvtu(
         }
     };
     let mut sig: Option<Signature> = None;
-    for (k, part) in parts.iter().enumerate() {
+    for (&k, part) in ids.iter().zip(parts) {
         let pp = path.with_file_name(format!("{stem}_{k}.vtu"));
         match write_piece(&pp, part, opts) {
             Ok(s) => {
@@ -549,7 +566,11 @@ pub fn write_pvtu(
             }
         }
     }
+    if !index {
+        return Ok(written);
+    }
     let sig = sig.unwrap_or_default();
+    let names: Vec<String> = (0..total).map(|k| format!("{stem}_{k}.vtu")).collect();
     let res = write_atomic(path, |w| {
         writeln!(w, "<?xml version=\"1.0\"?>")?;
         writeln!(
@@ -583,8 +604,7 @@ pub fn write_pvtu(
             }
             writeln!(w, "    </{tag}>")?;
         }
-        for p in &written {
-            let name = p.file_name().and_then(|n| n.to_str()).unwrap_or_default();
+        for name in &names {
             writeln!(w, "    <Piece Source=\"{}\"/>", xml_escape(name))?;
         }
         writeln!(w, "  </PUnstructuredGrid>\n</VTKFile>")

@@ -14,6 +14,7 @@
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
+mod check;
 mod ddg_build;
 mod pass;
 mod pockets;
@@ -26,6 +27,7 @@ use pockets::*;
 use schedule::{Partitions, Passes, Recorder};
 use serial::*;
 
+pub use check::{check_pieces, PieceCheck, PieceCheckError};
 pub use ddg_build::{build_ddg, DdgBuildStats};
 pub use parafront_ddg::Partition;
 pub use redistribute::Piece;
@@ -69,6 +71,9 @@ pub struct ParOptions {
     pub ddg_cap: f64,
     /// Test hook: redistribution fails on this part ([`PassError::Injected`]).
     pub fail_part: Option<usize>,
+    /// Merge the pieces into one mesh on part 0's process (true), or leave
+    /// them where they are (a partitioned output, memory distributed).
+    pub gather: bool,
 }
 
 pub use ddg_build::DDG_CAP;
@@ -89,6 +94,7 @@ impl Default for ParOptions {
             serial_from: SERIAL_FROM,
             ddg_cap: ddg_build::DDG_CAP,
             fail_part: None,
+            gather: true,
         }
     }
 }
@@ -279,8 +285,11 @@ pub struct ParOutput {
     pub tets: Vec<[u32; 4]>,
     /// Pass (1 to 4) that made each tet.
     pub tet_pass: Vec<u8>,
-    /// The partitioned mesh, one piece per part.
+    /// The partitioned mesh, one piece per part held here.
     pub pieces: Vec<Piece>,
+    /// The merged mesh's point count (on every process, with or without
+    /// the merged mesh).
+    pub n_points: u32,
     /// What the passes did.
     pub stats: ParStats,
 }
@@ -634,17 +643,22 @@ pub fn mesh_parallel_around<C: Comm>(
 
     // §8 step 4.
     let t0 = Instant::now();
-    let out = redistribute::run(
-        parts,
-        comm,
-        &loc,
-        &on.base,
-        points,
-        next_gid,
-        opts.fail_part,
-    )?;
+    let out = redistribute::run(parts, comm, &loc, &on.base, points, next_gid, opts)?;
     let held = comm.all_gather(out.pieces.iter().map(|p| p.tets.len()).collect());
-    Ok(rec.finish(out, held, t0.elapsed().as_secs_f64()))
+    let pass_tets = comm.all_reduce(
+        out.pieces
+            .iter()
+            .map(|pc| {
+                let mut n = [0usize; 4];
+                for &p in &pc.tet_pass {
+                    n[p as usize - 1] += 1;
+                }
+                n
+            })
+            .collect(),
+        |a, b| [0, 1, 2, 3].map(|i| a[i] + b[i]),
+    );
+    Ok(rec.finish(out, held, pass_tets, t0.elapsed().as_secs_f64()))
 }
 
 /// The DDG of the front: by `opts.ddg_passes` parallel passes, or by the

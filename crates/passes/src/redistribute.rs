@@ -65,8 +65,9 @@ pub(crate) fn run<C: Comm>(
     part0: &[u32],
     input: &[P3],
     n_gid: u32,
-    fail_part: Option<usize>,
+    opts: &crate::ParOptions,
 ) -> Result<ParOutput, PassError> {
+    let fail_part = opts.fail_part;
     // Each tet to the lowest part among its points' DDG hosts.
     let inbox = comm.exchange(send_tets(parts, comm.owned().start, loc, part0));
     // Each part: its points once, by exact key.
@@ -83,7 +84,9 @@ pub(crate) fn run<C: Comm>(
     // for pass 4 may have left points behind), input points first.
     let n = number_points(comm, &mut pieces, input.len(), n_gid);
     // The merged mesh, on part 0's process (the others send their pieces).
-    let (points, tets, tet_pass) = if comm.owned() == (0..comm.parts()) {
+    let (points, tets, tet_pass) = if !opts.gather {
+        (Vec::new(), Vec::new(), Vec::new())
+    } else if comm.owned() == (0..comm.parts()) {
         merge(&pieces, input, n)?
     } else {
         let out = pieces
@@ -123,6 +126,7 @@ pub(crate) fn run<C: Comm>(
         tets,
         tet_pass,
         pieces,
+        n_points: n,
         stats: Default::default(),
     })
 }

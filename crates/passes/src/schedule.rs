@@ -308,14 +308,18 @@ impl Recorder {
 
     /// Redistribution gave `out` in `seconds`: the tets each pass has in
     /// the final mesh, and what each part holds.
-    /// `held`: the tets of every part's piece.
-    pub(crate) fn finish(mut self, out: ParOutput, held: Vec<usize>, seconds: f64) -> ParOutput {
+    /// `held`: the tets of every part's piece; `pass_tets`: the tets each
+    /// pass has in the final mesh.
+    pub(crate) fn finish(
+        mut self,
+        out: ParOutput,
+        held: Vec<usize>,
+        pass_tets: [usize; 4],
+        seconds: f64,
+    ) -> ParOutput {
         let st = &mut self.st;
         st.redistribute_seconds = seconds;
-        st.pass_tets = [0; 4];
-        for &p in &out.tet_pass {
-            st.pass_tets[p as usize - 1] += 1;
-        }
+        st.pass_tets = pass_tets;
         st.held_imbalance = max_over_mean(&held, st.parts);
         ParOutput {
             stats: self.st,

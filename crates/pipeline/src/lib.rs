@@ -109,6 +109,18 @@ pub struct MeshOptions {
     /// default.
     #[serde(default)]
     pub fail_part: Option<usize>,
+    /// Merge the parts into one mesh (true, the default), or leave the mesh
+    /// in its pieces, on the processes that made them (false: a `.pvtu`
+    /// output, memory distributed under MPI). Off needs `parts` > 1 and
+    /// `optimize` 0 (improvement does not run on pieces yet), and turns the
+    /// lattice off (its tets are in no piece); the summary then has the
+    /// pieces, and the mesh returned is empty.
+    #[serde(default = "yes")]
+    pub gather: bool,
+}
+
+fn yes() -> bool {
+    true
 }
 
 fn default_thin_depth() -> f64 {
@@ -153,6 +165,7 @@ impl Default for MeshOptions {
             serial_from: default_serial_from(),
             ddg_cap: default_ddg_cap(),
             fail_part: None,
+            gather: true,
         }
     }
 }
@@ -220,6 +233,13 @@ pub enum MeshError {
     /// The mesh failed its final check.
     #[error("the generated mesh failed its check (this is a bug in parafront): {0}")]
     Check(#[from] CheckError),
+    /// The partitioned mesh (`gather` off) failed its check where it lies.
+    #[error("the generated mesh failed its check (this is a bug in parafront): {0}")]
+    PieceCheck(#[from] parafront_passes::PieceCheckError),
+    /// A partitioned output (`gather` off) that the options or the run do
+    /// not allow.
+    #[error("a partitioned output (.pvtu): {0}")]
+    Partitioned(String),
     /// Improvement (§9) found the front's tets not face-adjacent.
     #[error("mesh improvement: {source}")]
     Improve {
@@ -277,6 +297,26 @@ fn mesh_surface_here<C: Comm>(
     opts: &MeshOptions,
     comm: &C,
 ) -> Result<Option<(TetMesh, Summary)>, MeshError> {
+    let pieces_only;
+    let opts = if opts.gather {
+        opts
+    } else {
+        if opts.parts < 2 {
+            return Err(MeshError::Partitioned("it needs parts > 1".into()));
+        }
+        if opts.optimize > 0 {
+            return Err(MeshError::Partitioned(
+                "it is the mesh as the parallel passes left it: improvement (optimize) must be 0"
+                    .into(),
+            ));
+        }
+        // The lattice's tets would be in no piece.
+        pieces_only = MeshOptions {
+            lattice: LatticeMode::Off,
+            ..opts.clone()
+        };
+        &pieces_only
+    };
     let mut sum = Summary {
         threads: rayon::current_num_threads(),
         ..Summary::default()
@@ -334,6 +374,9 @@ fn mesh_surface_here<C: Comm>(
             comm,
             mesh_parallel_around,
         )?;
+        if !opts.gather {
+            return check_pieces(s, &fronts, opts, comm, sum).map(Some);
+        }
         if !holds_part0(comm) {
             return Ok(None);
         }
@@ -391,6 +434,53 @@ fn mesh_surface_here<C: Comm>(
     sum.points = mesh.points.len();
     sum.regions = fronts.len();
     Ok(Some((mesh, sum)))
+}
+
+/// The end of a partitioned run (`gather` off): the pieces checked where
+/// they lie, the counts summed over the processes; the mesh is empty.
+fn check_pieces<C: Comm>(
+    s: &Surface,
+    fronts: &[RegionFront],
+    opts: &MeshOptions,
+    comm: &C,
+    mut sum: Summary,
+) -> Result<(TetMesh, Summary), MeshError> {
+    let t0 = Instant::now();
+    // Region by region, one piece per part held here.
+    let held = comm.owned().len();
+    let mut by_part: Vec<Vec<&parafront_passes::Piece>> = vec![Vec::new(); held];
+    for (i, pc) in sum.pieces.iter().enumerate() {
+        by_part[i % held.max(1)].push(pc);
+    }
+    // Six times each region's volume, as its front (normals inward) bounds it.
+    let vol6: f64 = fronts
+        .iter()
+        .map(|rf| {
+            let p = |i: u32| s.points[rf.points[i as usize] as usize];
+            let o = rf.faces.first().map_or([0.0; 3], |f| p(f[0]));
+            rf.faces
+                .iter()
+                .map(|f| parafront_geom::tet_volume6(o, p(f[0]), p(f[2]), p(f[1])))
+                .sum::<f64>()
+                .abs()
+        })
+        .sum();
+    let tets = if opts.no_check {
+        comm.all_reduce(
+            by_part
+                .iter()
+                .map(|l| l.iter().map(|pc| pc.tets.len()).sum())
+                .collect(),
+            |a: usize, b| a + b,
+        )
+    } else {
+        parafront_passes::check_pieces(comm, &by_part, &s.tris, vol6)?.tets
+    };
+    drop(by_part);
+    sum.push(Stage::Check, t0.elapsed().as_secs_f64());
+    sum.tets = tets;
+    sum.regions = fronts.len();
+    Ok((TetMesh::default(), sum))
 }
 
 /// This process holds part 0, where the mesh gathers.
@@ -638,6 +728,8 @@ fn mesh_parts<C: Comm>(
     parallel: ParallelMesher<C>,
 ) -> Result<Vec<u32>, MeshError> {
     let holds = holds_part0(comm);
+    // Without the merged mesh, where each region's new points start.
+    let mut next_base = s.points.len() as u32;
     // The lattice's inner points, for improvement to leave alone.
     let mut lattice_inner = Vec::new();
     let field = |p| sizing.size(p);
@@ -657,6 +749,7 @@ fn mesh_parts<C: Comm>(
         serial_from: opts.serial_from,
         ddg_cap: opts.ddg_cap,
         fail_part: opts.fail_part,
+        gather: opts.gather,
         ..ParOptions::default()
     };
     // Seconds of each of `Stage::PARALLEL`, summed over the regions.
@@ -693,6 +786,12 @@ fn mesh_parts<C: Comm>(
                 sum.serial_fallback
                     .push((rf.region_id as usize, e.to_string()));
                 sum.push(Stage::PassesGivenUp, t_par.elapsed().as_secs_f64());
+                if !opts.gather {
+                    return Err(MeshError::Partitioned(format!(
+                        "region {}: the parallel passes gave way ({e}), and the serial front makes no pieces",
+                        rf.region_id
+                    )));
+                }
                 if !holds {
                     continue; // the serial front runs where the mesh gathers
                 }
@@ -710,14 +809,6 @@ fn mesh_parts<C: Comm>(
                 })
             }
         };
-        if !holds {
-            sum.parallel.push(out.stats);
-            continue;
-        }
-        let mut tets = out.tets;
-        tets.extend(lattice.tets.iter().map(|t| t.map(|v| v + n_in)));
-        let base = append_region(mesh, rf, &out.points, &tets);
-        note_lattice(&lattice, base, sum, &mut lattice_inner);
         let st = &out.stats;
         for (k, x) in [
             st.ddg_seconds,
@@ -733,6 +824,27 @@ fn mesh_parts<C: Comm>(
         {
             stage[k] += x;
         }
+        if !opts.gather {
+            let base = next_base;
+            next_base += out.n_points - pts.len() as u32;
+            sum.points = next_base as usize;
+            for mut pc in out.pieces {
+                for g in &mut pc.gid {
+                    *g = global_id(rf, base, *g);
+                }
+                sum.pieces.push(pc);
+            }
+            sum.parallel.push(out.stats);
+            continue;
+        }
+        if !holds {
+            sum.parallel.push(out.stats);
+            continue;
+        }
+        let mut tets = out.tets;
+        tets.extend(lattice.tets.iter().map(|t| t.map(|v| v + n_in)));
+        let base = append_region(mesh, rf, &out.points, &tets);
+        note_lattice(&lattice, base, sum, &mut lattice_inner);
         // The lattice's tets are in no piece: no pieces then (`--pvtu`
         // turns the lattice off).
         if lattice.tets.is_empty() {

@@ -1,0 +1,317 @@
+//! The check of a partitioned mesh where it lies (the pieces of §8, not
+//! merged: memory stays distributed). The merged mesh's check without the
+//! merge: every tet positive (exactly, and in floating point, as a solver
+//! computes it), every face in at most two tets seen from opposite sides
+//! (within a piece, then across pieces by an exact key sent to one part),
+//! the faces in one tet exactly the input triangles, and the volumes
+//! adding up to the enclosed volume.
+use crate::Piece;
+use parafront_comm::Comm;
+use parafront_geom::{orient3d, tet_volume6};
+use rayon::prelude::*;
+use rustc_hash::FxHashSet;
+
+/// A face by its global point ids, rotated so the smallest comes first and
+/// the next two ascending, with whether that kept the orientation.
+type Key = [u32; 3];
+
+/// Faces of a positive tet, outward.
+const OUTWARD: [[usize; 3]; 4] = [[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]];
+
+fn canon(w: [u32; 3]) -> (Key, bool) {
+    let r = (0..3).min_by_key(|&k| w[k]).unwrap_or(0);
+    let (a, b, c) = (w[r], w[(r + 1) % 3], w[(r + 2) % 3]);
+    if b < c {
+        ([a, b, c], true)
+    } else {
+        ([a, c, b], false)
+    }
+}
+
+/// What the check counted, over all pieces.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct PieceCheck {
+    /// Tets.
+    pub tets: usize,
+    /// Faces in one tet (the input triangles on the outside).
+    pub boundary_faces: usize,
+    /// Faces whose two tets lie in different pieces.
+    pub cut_faces: usize,
+    /// The tets' volume.
+    pub volume: f64,
+}
+
+/// What is wrong with the pieces (a defect of the mesher, never of the
+/// input), as the process that found it says it.
+#[derive(Debug, thiserror::Error, PartialEq)]
+#[error("partitioned mesh: {message}")]
+pub struct PieceCheckError {
+    /// The first fault found, by part.
+    pub message: String,
+}
+
+/// Checks the pieces this process holds, `pieces[i]` those of part
+/// `owned().start + i` (one per region), against the input triangles
+/// `tris` (the pieces' global ids) and six times the enclosed volume.
+/// Every process gets the same answer.
+pub fn check_pieces<C: Comm>(
+    comm: &C,
+    pieces: &[Vec<&Piece>],
+    tris: &[[u32; 3]],
+    enclosed_vol6: f64,
+) -> Result<PieceCheck, PieceCheckError> {
+    let np = comm.parts() as u64;
+    let input: FxHashSet<Key> = tris.iter().map(|&t| canon(t).0).collect();
+    let home = |k: &Key| -> u32 {
+        let h = (k[0] as u64)
+            .wrapping_mul(0x9E37_79B9_7F4A_7C15)
+            .wrapping_add((k[1] as u64).wrapping_mul(0xC2B2_AE3D_27D4_EB4F))
+            .wrapping_add((k[2] as u64).wrapping_mul(0x1656_67B1_9E37_79F9));
+        ((h >> 32) % np) as u32
+    };
+    struct Local {
+        fault: Option<String>,
+        tets: usize,
+        vol6: f64,
+        covered: usize,
+        out: Vec<(u32, (Key, bool))>,
+    }
+    let local: Vec<Local> = pieces
+        .par_iter()
+        .enumerate()
+        .map(|(i, list)| {
+            let part = comm.owned().start + i;
+            let mut l = Local {
+                fault: None,
+                tets: 0,
+                vol6: 0.0,
+                covered: 0,
+                out: Vec::new(),
+            };
+            let mut faces: Vec<(Key, bool)> = Vec::new();
+            for pc in list {
+                for (t, tv) in pc.tets.iter().enumerate() {
+                    let p = tv.map(|i| pc.points[i as usize]);
+                    let v6 = tet_volume6(p[0], p[1], p[2], p[3]);
+                    if !(orient3d(p[0], p[1], p[2], p[3]) > 0.0 && v6 > 0.0) {
+                        l.fault.get_or_insert(format!(
+                            "part {part}: tet {} (global points {:?}) is not positive",
+                            pc.tet_gid.get(t).copied().unwrap_or(t as u32),
+                            tv.map(|i| pc.gid[i as usize])
+                        ));
+                    }
+                    l.vol6 += v6;
+                    for f in OUTWARD {
+                        faces.push(canon(f.map(|j| pc.gid[tv[j] as usize])));
+                    }
+                }
+                l.tets += pc.tets.len();
+            }
+            faces.par_sort_unstable();
+            let mut i = 0;
+            while i < faces.len() {
+                let mut j = i + 1;
+                while j < faces.len() && faces[j].0 == faces[i].0 {
+                    j += 1;
+                }
+                match &faces[i..j] {
+                    [a] => l.out.push((home(&a.0), *a)),
+                    [a, b] if a.1 != b.1 => l.covered += input.contains(&a.0) as usize,
+                    _ => {
+                        l.fault.get_or_insert(format!(
+                            "part {part}: face {:?} is in {} tets of one piece, or in two on one side",
+                            faces[i].0,
+                            j - i
+                        ));
+                    }
+                }
+                i = j;
+            }
+            l
+        })
+        .collect();
+    let mut outs = Vec::with_capacity(local.len());
+    let mut sums = Vec::with_capacity(local.len());
+    for l in local {
+        sums.push((l.fault, l.tets, l.vol6, l.covered));
+        outs.push(l.out);
+    }
+    // Faces on a piece's boundary, each at its home part.
+    let inbox = comm.exchange(outs);
+    let homes: Vec<(Option<String>, usize, usize, usize)> = inbox
+        .into_par_iter()
+        .enumerate()
+        .map(|(i, msgs)| {
+            let part = comm.owned().start + i;
+            let mut f: Vec<(Key, bool)> = msgs.into_iter().map(|m| m.1).collect();
+            f.par_sort_unstable();
+            let (mut fault, mut covered, mut boundary, mut cut) = (None, 0, 0, 0);
+            let mut i = 0;
+            while i < f.len() {
+                let mut j = i + 1;
+                while j < f.len() && f[j].0 == f[i].0 {
+                    j += 1;
+                }
+                let is_input = input.contains(&f[i].0);
+                match &f[i..j] {
+                    [_] if is_input => {
+                        covered += 1;
+                        boundary += 1;
+                    }
+                    [a] => {
+                        fault.get_or_insert(format!(
+                            "face {:?} is in one tet but no input triangle (checked by part {part})",
+                            a.0
+                        ));
+                    }
+                    [a, b] if a.1 != b.1 => {
+                        covered += is_input as usize;
+                        cut += 1;
+                    }
+                    _ => {
+                        fault.get_or_insert(format!(
+                            "face {:?} is in {} tets of several pieces, or in two on one side",
+                            f[i].0,
+                            j - i
+                        ));
+                    }
+                }
+                i = j;
+            }
+            (fault, covered, boundary, cut)
+        })
+        .collect();
+    // (fault, (tets, 6 x volume), (input triangles covered, boundary, cut)).
+    type Sums = (Option<String>, (usize, f64), (usize, usize, usize));
+    let all: Sums = comm.all_reduce(
+        sums.into_iter()
+            .zip(homes)
+            .map(|((f1, tets, v, c1), (f2, c2, b, cut))| (f1.or(f2), (tets, v), (c1 + c2, b, cut)))
+            .collect(),
+        |a: Sums, b: Sums| {
+            (
+                a.0.or(b.0),
+                (a.1 .0 + b.1 .0, a.1 .1 + b.1 .1),
+                (a.2 .0 + b.2 .0, a.2 .1 + b.2 .1, a.2 .2 + b.2 .2),
+            )
+        },
+    );
+    let (fault, (tets, vol6), (covered, boundary_faces, cut_faces)) = all;
+    if let Some(message) = fault {
+        return Err(PieceCheckError { message });
+    }
+    if covered != input.len() {
+        return Err(PieceCheckError {
+            message: format!(
+                "{} of {} input triangles are no face of the mesh",
+                input.len() - covered.min(input.len()),
+                input.len()
+            ),
+        });
+    }
+    if (vol6 - enclosed_vol6).abs() > 1e-9 * enclosed_vol6.abs().max(f64::MIN_POSITIVE) {
+        return Err(PieceCheckError {
+            message: format!(
+                "the tets' volume {} is not the enclosed volume {}",
+                vol6 / 6.0,
+                enclosed_vol6 / 6.0
+            ),
+        });
+    }
+    Ok(PieceCheck {
+        tets,
+        boundary_faces,
+        cut_faces,
+        volume: vol6 / 6.0,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use parafront_comm::Threads;
+
+    /// A box mesh in two pieces (by centroid), its boundary triangles, and
+    /// six times its volume.
+    fn two_pieces() -> (Vec<Piece>, Vec<[u32; 3]>, f64) {
+        let m = parafront_mesh::generate::box_mesh(4, 3, 2, [0.0; 3], [2.0, 1.5, 1.0]);
+        let tets: Vec<[u32; 4]> = m.tets.iter().map(|t| t.map(|p| p.raw())).collect();
+        let mut faces: Vec<(Key, bool, [u32; 3])> = Vec::new();
+        for t in &tets {
+            for f in OUTWARD {
+                let w = f.map(|j| t[j]);
+                let (k, o) = canon(w);
+                faces.push((k, o, w));
+            }
+        }
+        faces.sort_unstable();
+        let mut tris = Vec::new();
+        let mut i = 0;
+        while i < faces.len() {
+            if i + 1 < faces.len() && faces[i + 1].0 == faces[i].0 {
+                i += 2;
+            } else {
+                tris.push(faces[i].2);
+                i += 1;
+            }
+        }
+        let mut pieces = vec![Piece::default(), Piece::default()];
+        for pc in &mut pieces {
+            pc.points = m.points.clone();
+            pc.gid = (0..m.points.len() as u32).collect();
+        }
+        for (t, tv) in tets.iter().enumerate() {
+            let cx: f64 = tv.iter().map(|&p| m.points[p as usize][0]).sum::<f64>() / 4.0;
+            let pc = &mut pieces[(cx > 1.0) as usize];
+            pc.tets.push(*tv);
+            pc.tet_gid.push(t as u32);
+            pc.tet_pass.push(1);
+        }
+        (pieces, tris, 6.0 * 2.0 * 1.5 * 1.0)
+    }
+
+    fn check(
+        pieces: &[Piece],
+        tris: &[[u32; 3]],
+        vol6: f64,
+    ) -> Result<PieceCheck, PieceCheckError> {
+        let by_part: Vec<Vec<&Piece>> = pieces.iter().map(|p| vec![p]).collect();
+        check_pieces(&Threads::new(pieces.len()), &by_part, tris, vol6)
+    }
+
+    #[test]
+    fn sound_pieces_pass_and_each_fault_is_found() {
+        let (pieces, tris, vol6) = two_pieces();
+        let n: usize = pieces.iter().map(|p| p.tets.len()).sum();
+        let st = check(&pieces, &tris, vol6).expect("sound");
+        assert_eq!(st.tets, n);
+        assert_eq!(st.boundary_faces, tris.len());
+        assert!(st.cut_faces > 0);
+        assert!((st.volume - 3.0).abs() < 1e-12);
+
+        // A tet turned inside out.
+        let mut bad = pieces.clone();
+        bad[1].tets[0].swap(0, 1);
+        let e = check(&bad, &tris, vol6).unwrap_err();
+        assert!(e.message.contains("not positive"), "{e}");
+        // A tet missing: a hole whose faces are no input triangles.
+        let mut bad = pieces.clone();
+        bad[0].tets.pop();
+        let e = check(&bad, &tris, vol6).unwrap_err();
+        assert!(e.message.contains("no input triangle"), "{e}");
+        // A tet in both pieces: its faces in too many tets.
+        let mut bad = pieces.clone();
+        let t = bad[0].tets[0];
+        bad[1].tets.push(t);
+        let e = check(&bad, &tris, vol6).unwrap_err();
+        assert!(e.message.contains("several pieces"), "{e}");
+        // An input triangle the mesh lacks.
+        let mut more = tris.clone();
+        more.push([0, 1, 7]);
+        let e = check(&pieces, &more, vol6).unwrap_err();
+        assert!(e.message.contains("input triangles are no face"), "{e}");
+        // The wrong enclosed volume.
+        let e = check(&pieces, &tris, 2.0 * vol6).unwrap_err();
+        assert!(e.message.contains("volume"), "{e}");
+    }
+}
