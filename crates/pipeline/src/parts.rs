@@ -1,0 +1,278 @@
+//! Steps 4 to 6 of the pipeline for one surface (§5 to §8): the parallel
+//! mesher on each region, its parts' messages through a `Comm`, and the end
+//! of a partitioned run whose mesh stays in its pieces.
+use super::*;
+
+/// The parallel mesher (§5 to §8, `parallel`: `mesh_parallel`, or one
+/// that fails in tests) on each region, its parts' messages through
+/// `comm`; the merged result goes into `mesh` like the serial front's, on
+/// the process of part 0 (the others leave `mesh` as it is).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn mesh_parts<C: Comm>(
+    s: &Surface,
+    fronts: &[RegionFront],
+    sizing: &Sizing,
+    opts: &MeshOptions,
+    mesh: &mut TetMesh,
+    sum: &mut Summary,
+    comm: &C,
+    parallel: ParallelMesher<C>,
+) -> Result<Vec<u32>, MeshError> {
+    let holds = holds_part0(comm);
+    // Without the merged mesh, where each region's new points start.
+    let mut next_base = s.points.len() as u32;
+    // The lattice's inner points, for improvement to leave alone.
+    let mut lattice_inner = Vec::new();
+    let field = |p| sizing.size(p);
+    let popts = ParOptions {
+        parts: opts.parts,
+        growth: if opts.ddg_growth > 0.0 {
+            opts.ddg_growth
+        } else {
+            parafront_ddg::DEFAULT_GROWTH
+        },
+        partition: opts.partition,
+        ddg_passes: opts
+            .ddg_passes
+            .unwrap_or(parafront_passes::DEFAULT_DDG_PASSES),
+        fill_after: opts.fill_after,
+        thin_depth: opts.thin_depth,
+        serial_from: opts.serial_from,
+        ddg_cap: opts.ddg_cap,
+        fail_part: opts.fail_part,
+        gather: opts.gather,
+        ..ParOptions::default()
+    };
+    // Seconds of each of `Stage::PARALLEL`, summed over the regions.
+    let mut stage = [0.0f64; Stage::PARALLEL.len()];
+    for rf in fronts {
+        let (mut pts, mut hs) = region_points(s, sizing, rf);
+        // The lattice fills the core; the passes mesh the layer between it
+        // and the surface.
+        let n_in = pts.len() as u32;
+        let lattice = region_lattice(&pts, &hs, rf, sizing, opts, sum);
+        pts.extend_from_slice(&lattice.points);
+        hs.extend_from_slice(&lattice.size);
+        let core: Vec<[u32; 3]> = lattice.faces.iter().map(|f| f.map(|v| v + n_in)).collect();
+        let t_par = Instant::now();
+        let out = match parallel(&pts, &hs, &rf.faces, &core, &field, &popts, comm) {
+            Ok(out) => out,
+            // A valid surface must not fail (AF5, step 4): a front the
+            // passes leave unclosable (CAD needles next to a part wall) gets
+            // the serial front, which recovers from the input surface. So
+            // does a thin part whose passes leave most of it to pass 4.
+            Err(
+                e @ (PassError::Pass { .. }
+                | PassError::Remote {
+                    pass_failed: true, ..
+                }
+                | PassError::Unsuited { .. }
+                | PassError::Thin { .. }
+                | PassError::Ddg(DdgError::Front(_))),
+            ) => {
+                tracing::warn!(
+                    region = rf.region_id,
+                    "parallel passes given up ({e}); meshing serially"
+                );
+                sum.serial_fallback
+                    .push((rf.region_id as usize, e.to_string()));
+                sum.push(Stage::PassesGivenUp, t_par.elapsed().as_secs_f64());
+                if !opts.gather {
+                    return Err(MeshError::Partitioned(format!(
+                        "region {}: the parallel passes gave way ({e}), and the serial front makes no pieces",
+                        rf.region_id
+                    )));
+                }
+                if !holds {
+                    continue; // the serial front runs where the mesh gathers
+                }
+                let t0 = Instant::now();
+                let lat0 = sum.seconds(Stage::Lattice);
+                serial_region(s, rf, sizing, opts, mesh, sum, &mut lattice_inner)?;
+                let lat = sum.seconds(Stage::Lattice) - lat0;
+                sum.push(Stage::Front, t0.elapsed().as_secs_f64() - lat);
+                continue;
+            }
+            Err(e) => {
+                return Err(MeshError::Parallel {
+                    region: rf.region_id as usize,
+                    source: e,
+                })
+            }
+        };
+        let st = &out.stats;
+        for (k, x) in [
+            st.ddg_seconds,
+            st.partition_seconds,
+            st.pass_seconds[0],
+            st.pass_seconds[1],
+            st.pass_seconds[2],
+            st.pass_seconds[3],
+            st.redistribute_seconds,
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            stage[k] += x;
+        }
+        if !opts.gather {
+            let base = next_base;
+            next_base += out.n_points - pts.len() as u32;
+            sum.points = next_base as usize;
+            for mut pc in out.pieces {
+                for g in &mut pc.gid {
+                    *g = global_id(rf, base, *g);
+                }
+                sum.pieces.push(pc);
+            }
+            sum.parallel.push(out.stats);
+            continue;
+        }
+        if !holds {
+            sum.parallel.push(out.stats);
+            continue;
+        }
+        let mut tets = out.tets;
+        tets.extend(lattice.tets.iter().map(|t| t.map(|v| v + n_in)));
+        let base = append_region(mesh, rf, &out.points, &tets);
+        note_lattice(&lattice, base, sum, &mut lattice_inner);
+        // The lattice's tets are in no piece: no pieces then (`--pvtu`
+        // turns the lattice off).
+        if lattice.tets.is_empty() {
+            for mut pc in out.pieces {
+                for g in &mut pc.gid {
+                    *g = global_id(rf, base, *g);
+                }
+                sum.pieces.push(pc);
+            }
+        }
+        sum.parallel.push(out.stats);
+    }
+    if sum.parallel.is_empty() {
+        return Ok(lattice_inner); // every region went to the serial front
+    }
+    for (name, x) in Stage::PARALLEL.into_iter().zip(stage) {
+        sum.push(name, x);
+    }
+    Ok(lattice_inner)
+}
+
+type ParallelMesher<C> = fn(
+    &[parafront_geom::P3],
+    &[f64],
+    &[[u32; 3]],
+    &[[u32; 3]],
+    &(dyn Fn(parafront_geom::P3) -> f64 + Sync),
+    &ParOptions,
+    &C,
+) -> Result<ParOutput, PassError>;
+
+/// The end of a partitioned run (`gather` off): the pieces checked where
+/// they lie, the counts summed over the processes; the mesh is empty.
+pub(crate) fn finish_pieces<C: Comm>(
+    s: &Surface,
+    fronts: &[RegionFront],
+    opts: &MeshOptions,
+    comm: &C,
+    mut sum: Summary,
+) -> Result<(TetMesh, Summary), MeshError> {
+    let t0 = Instant::now();
+    // Region by region, one piece per part held here.
+    let held = comm.owned().len();
+    let mut by_part: Vec<Vec<&parafront_passes::Piece>> = vec![Vec::new(); held];
+    for (i, pc) in sum.pieces.iter().enumerate() {
+        by_part[i % held.max(1)].push(pc);
+    }
+    // Six times each region's volume, as its front (normals inward) bounds it.
+    let vol6: f64 = fronts
+        .iter()
+        .map(|rf| {
+            let p = |i: u32| s.points[rf.points[i as usize] as usize];
+            let o = rf.faces.first().map_or([0.0; 3], |f| p(f[0]));
+            rf.faces
+                .iter()
+                .map(|f| parafront_geom::tet_volume6(o, p(f[0]), p(f[2]), p(f[1])))
+                .sum::<f64>()
+                .abs()
+        })
+        .sum();
+    let tets = if opts.no_check {
+        comm.all_reduce(
+            by_part
+                .iter()
+                .map(|l| l.iter().map(|pc| pc.tets.len()).sum())
+                .collect(),
+            |a: usize, b| a + b,
+        )
+    } else {
+        parafront_passes::check_pieces(comm, &by_part, &s.tris, vol6)?.tets
+    };
+    drop(by_part);
+    sum.push(Stage::Check, t0.elapsed().as_secs_f64());
+    sum.tets = tets;
+    sum.regions = fronts.len();
+    Ok((TetMesh::default(), sum))
+}
+
+/// This process holds part 0, where the mesh gathers.
+pub(crate) fn holds_part0<C: Comm>(comm: &C) -> bool {
+    comm.owned().start == 0 && !comm.owned().is_empty()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use parafront_surface::generate;
+
+    /// A pass that cannot close its front must not fail the run: the
+    /// region goes to the serial front, and the summary says so.
+    #[test]
+    fn failed_passes_fall_back_to_the_serial_front() {
+        fn stuck(
+            _: &[parafront_geom::P3],
+            _: &[f64],
+            _: &[[u32; 3]],
+            _: &[[u32; 3]],
+            _: &(dyn Fn(parafront_geom::P3) -> f64 + Sync),
+            _: &ParOptions,
+            _: &parafront_comm::Threads,
+        ) -> Result<ParOutput, PassError> {
+            Err(PassError::Pass {
+                pass: 4,
+                part: 0,
+                source: FrontError::Stuck {
+                    rounds: 60,
+                    faces: 12,
+                    x: 0.0,
+                    y: 0.0,
+                    z: 0.0,
+                    partial: None,
+                },
+            })
+        }
+        let s = generate::torus([0.0; 3], 2.0, 0.7, 24, 12);
+        let report = validate(&s);
+        assert!(report.is_valid());
+        let fronts = material_regions(&s, &report.shells);
+        let opts = MeshOptions {
+            parts: 4,
+            ..MeshOptions::default()
+        };
+        let sizing = Sizing::build(&s, &opts.size, None).unwrap();
+        let mut mesh = surface_mesh(&s);
+        let mut sum = Summary::default();
+        let comm = parafront_comm::Threads::new(opts.parts);
+        mesh_parts(
+            &s, &fronts, &sizing, &opts, &mut mesh, &mut sum, &comm, stuck,
+        )
+        .unwrap();
+        assert_eq!(sum.serial_fallback.len(), 1);
+        assert_eq!(sum.serial_fallback[0].0, 1);
+        assert!(sum.serial_fallback[0].1.contains("pass 4"));
+        assert!(sum.parallel.is_empty());
+        mesh.build_adjacency().unwrap();
+        mesh.check_against_surface(&s.tris).unwrap();
+        let v = mesh.volume();
+        assert!((v - s.signed_volume()).abs() < 1e-9 * v, "{v}");
+    }
+}
