@@ -43,18 +43,26 @@ fn key(p: P3) -> Key {
 /// A piece with its points' exact keys (for the shared lists).
 type Keyed = (Piece, FxHashMap<Key, u32>);
 
-struct TetMsg {
-    v: [(u32, P3); 4],
-    pass: u8,
+/// The tets one part sends another: their points once each (global id,
+/// where it is), then the tets by global ids and the pass that made each.
+/// A tet as four located points was 113 bytes, most of the peak memory of
+/// a run on parts.
+#[derive(Default)]
+struct Batch {
+    points: Vec<(u32, P3)>,
+    tets: Vec<[u32; 4]>,
+    pass: Vec<u8>,
 }
 
-impl Wire for TetMsg {
+impl Wire for Batch {
     fn put(&self, buf: &mut Vec<u8>) {
-        (self.v, self.pass).put(buf);
+        self.points.put(buf);
+        self.tets.put(buf);
+        self.pass.put(buf);
     }
     fn get(buf: &mut &[u8]) -> Result<Self, WireError> {
-        let (v, pass) = Wire::get(buf)?;
-        Ok(TetMsg { v, pass })
+        let (points, tets, pass) = Wire::get(buf)?;
+        Ok(Batch { points, tets, pass })
     }
 }
 
@@ -149,39 +157,55 @@ fn agreed<C: Comm, T>(comm: &C, r: Result<T, PassError>) -> Result<T, PassError>
 }
 
 /// Each part's tets, addressed to the lowest part among their points' DDG
-/// hosts.
+/// hosts, one batch per destination (tets in their order).
 fn send_tets(
     parts: Vec<Part>,
     start: usize,
     loc: &Locator,
     part0: &[u32],
-) -> Vec<Vec<(u32, TetMsg)>> {
+) -> Vec<Vec<(u32, Batch)>> {
     parts
         .into_par_iter()
         .enumerate()
         .map(|(i, part)| {
             let k = start + i;
             let mut host: Vec<Option<u32>> = vec![None; part.pts.len()];
-            let mut out = Vec::with_capacity(part.tets.len());
-            for (t, tv) in part.tets.iter().enumerate() {
-                let dst = tv
-                    .iter()
-                    .map(|&i| {
-                        *host[i as usize].get_or_insert_with(|| {
-                            loc.lowest_host(part.pts[i as usize], part0)
-                                .unwrap_or(k as u32)
+            let dst: Vec<u32> = part
+                .tets
+                .iter()
+                .map(|tv| {
+                    tv.iter()
+                        .map(|&i| {
+                            *host[i as usize].get_or_insert_with(|| {
+                                loc.lowest_host(part.pts[i as usize], part0)
+                                    .unwrap_or(k as u32)
+                            })
                         })
-                    })
-                    .min()
-                    .unwrap();
-                let v = tv.map(|i| (part.gid[i as usize], part.pts[i as usize]));
-                out.push((
-                    dst,
-                    TetMsg {
-                        v,
-                        pass: part.tet_pass[t],
-                    },
-                ));
+                        .min()
+                        .unwrap()
+                })
+                .collect();
+            drop(host);
+            // By destination, each in tet order (a stable sort).
+            let mut order: Vec<u32> = (0..part.tets.len() as u32).collect();
+            order.sort_by_key(|&t| dst[t as usize]);
+            let mut stamp = vec![u32::MAX; part.pts.len()];
+            let mut out = Vec::new();
+            for group in order.chunk_by(|&a, &b| dst[a as usize] == dst[b as usize]) {
+                let d = dst[group[0] as usize];
+                let mut b = Batch::default();
+                for &t in group {
+                    let tv = part.tets[t as usize];
+                    for &p in &tv {
+                        if stamp[p as usize] != d {
+                            stamp[p as usize] = d;
+                            b.points.push((part.gid[p as usize], part.pts[p as usize]));
+                        }
+                    }
+                    b.tets.push(tv.map(|p| part.gid[p as usize]));
+                    b.pass.push(part.tet_pass[t as usize]);
+                }
+                out.push((d, b));
             }
             out
         })
@@ -190,31 +214,35 @@ fn send_tets(
 
 /// Each part's received tets as a piece, its points once by exact key
 /// (with the key map, for the shared lists).
-fn receive_tets(inbox: Vec<Vec<(u32, TetMsg)>>) -> Result<Vec<Keyed>, PassError> {
+fn receive_tets(inbox: Vec<Vec<(u32, Batch)>>) -> Result<Vec<Keyed>, PassError> {
     inbox
         .into_par_iter()
         .map(|msgs| {
             let mut pc = Piece::default();
             let mut map: FxHashMap<Key, u32> = FxHashMap::default();
-            for (_, m) in &msgs {
-                let mut tv = [0u32; 4];
-                for (c, &(g, p)) in m.v.iter().enumerate() {
-                    let i = *map.entry(key(p)).or_insert_with(|| {
-                        pc.points.push(p);
-                        pc.gid.push(g);
-                        pc.points.len() as u32 - 1
-                    });
-                    if pc.gid[i as usize] != g {
-                        return Err(PassError::Coincident {
-                            a: pc.gid[i as usize],
-                            b: g,
-                            at: p,
+            for (_, b) in msgs {
+                let at: FxHashMap<u32, P3> = b.points.into_iter().collect();
+                for (tv, pass) in b.tets.into_iter().zip(b.pass) {
+                    let mut t = [0u32; 4];
+                    for (c, g) in tv.into_iter().enumerate() {
+                        let p = at[&g];
+                        let i = *map.entry(key(p)).or_insert_with(|| {
+                            pc.points.push(p);
+                            pc.gid.push(g);
+                            pc.points.len() as u32 - 1
                         });
+                        if pc.gid[i as usize] != g {
+                            return Err(PassError::Coincident {
+                                a: pc.gid[i as usize],
+                                b: g,
+                                at: p,
+                            });
+                        }
+                        t[c] = i;
                     }
-                    tv[c] = i;
+                    pc.tets.push(t);
+                    pc.tet_pass.push(pass);
                 }
-                pc.tets.push(tv);
-                pc.tet_pass.push(m.pass);
             }
             Ok((pc, map))
         })
