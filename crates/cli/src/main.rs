@@ -477,12 +477,6 @@ pub(crate) fn run_mesh_on<C: Comm>(
         if a.pvtu.is_some() {
             return Err(Fail(2, "-o is a .pvtu already: leave out --pvtu".into()));
         }
-        if opts.optimize > 0 {
-            return Err(Fail(
-                2,
-                "-o .pvtu writes the mesh as the parallel passes left it: add --optimize 0".into(),
-            ));
-        }
         opts.gather = false;
     } else if parafront_io::Format::from_path(out).is_none() {
         return Err(Fail(

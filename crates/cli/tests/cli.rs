@@ -337,55 +337,78 @@ fn parts_write_a_partitioned_mesh() {
 }
 
 /// `-o x.pvtu`: the mesh stays in its pieces (no merged mesh; under MPI
-/// each process writes its own). They hold the tets the summary gives,
-/// which are the tets of the merged run; improvement must be off.
+/// each process writes its own), improved piece by piece with a shift
+/// between two rounds (§9.5). The pieces hold the tets the summary gives,
+/// and merged by their global ids they are a valid mesh of the surface.
+/// Without improvement they are the merged run's tets.
 #[test]
 fn a_pvtu_output_keeps_the_pieces() {
+    let demo = parafront_surface::generate::demo_part();
+    let pieces = |args: &[&str], pv: &Path| -> (usize, String, parafront_mesh::TetMesh) {
+        let o = bin().args(args).arg("-o").arg(pv).output().unwrap();
+        let text = String::from_utf8_lossy(&o.stdout).to_string();
+        assert!(
+            o.status.success(),
+            "{text}{}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        let said: usize = text
+            .lines()
+            .find_map(|l| l.strip_suffix(" regions"))
+            .and_then(|l| l.split(' ').next())
+            .and_then(|n| n.parse().ok())
+            .expect("the tet count");
+        let index = std::fs::read_to_string(pv).unwrap();
+        let names: Vec<&str> = index
+            .split("Source=\"")
+            .skip(1)
+            .map(|s| s.split('"').next().unwrap())
+            .collect();
+        // Two regions on four parts.
+        assert_eq!(names.len(), 8, "{index}");
+        // Merged by exact coordinates, the surface's points first.
+        let mut m = parafront_mesh::TetMesh {
+            points: demo.points.clone(),
+            ..Default::default()
+        };
+        let mut id: std::collections::HashMap<[u64; 3], u32> = demo
+            .points
+            .iter()
+            .enumerate()
+            .map(|(i, p)| (p.map(f64::to_bits), i as u32))
+            .collect();
+        for (k, n) in names.iter().enumerate() {
+            let piece = parafront_io::read_mesh(&pv.parent().unwrap().join(n)).unwrap();
+            // Pieces go region by region, four each.
+            m.region.extend(std::iter::repeat_n(k as u32 / 4, piece.tets.len()));
+            let local: Vec<u32> = piece
+                .points
+                .iter()
+                .map(|p| {
+                    *id.entry(p.map(f64::to_bits)).or_insert_with(|| {
+                        m.points.push(*p);
+                        m.points.len() as u32 - 1
+                    })
+                })
+                .collect();
+            m.tets.extend(
+                piece
+                    .tets
+                    .iter()
+                    .map(|t| t.map(|p| parafront_mesh::PointId::from_raw(local[p.idx()]))),
+            );
+        }
+        (said, text, m)
+    };
     let pv = tmp("demo_pieces.pvtu");
-    let o = bin()
-        .args(["demo", "--parts", "4", "-o"])
-        .arg(&pv)
-        .output()
-        .unwrap();
-    assert_eq!(o.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&o.stderr).contains("--optimize 0"));
-    assert!(!pv.exists());
-    let o = bin()
-        .args(["demo", "--parts", "4", "--optimize", "0", "-o"])
-        .arg(&pv)
-        .output()
-        .unwrap();
-    let text = String::from_utf8_lossy(&o.stdout).to_string();
-    assert!(
-        o.status.success(),
-        "{text}{}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-    let said: usize = text
-        .lines()
-        .find_map(|l| l.strip_suffix(" regions"))
-        .and_then(|l| l.split(' ').next())
-        .and_then(|n| n.parse().ok())
-        .expect("the tet count");
-    let pvtu = std::fs::read_to_string(&pv).unwrap();
-    let names: Vec<&str> = pvtu
-        .split("Source=\"")
-        .skip(1)
-        .map(|s| s.split('"').next().unwrap())
-        .collect();
-    // Two regions on four parts.
-    assert_eq!(names.len(), 8, "{pvtu}");
-    let total: usize = names
-        .iter()
-        .map(|n| {
-            parafront_io::read_mesh(&pv.parent().unwrap().join(n))
-                .unwrap()
-                .tets
-                .len()
-        })
-        .sum();
-    assert_eq!(total, said);
-    // The merged run makes the same tets.
+    let (said, text, m) = pieces(&["demo", "--parts", "4"], &pv);
+    assert_eq!(m.tets.len(), said);
+    assert!(text.contains("quality: min dihedral"), "{text}");
+    m.check_against_surface(&demo.tris).unwrap();
+    // Without improvement: the merged run's tets.
+    let pv0 = tmp("demo_pieces0.pvtu");
+    let (said0, _, m0) = pieces(&["demo", "--parts", "4", "--optimize", "0"], &pv0);
+    m0.check_against_surface(&demo.tris).unwrap();
     let vol = tmp("demo_merged.vtu");
     let o = bin()
         .args(["demo", "--parts", "4", "--optimize", "0", "-o"])
@@ -393,7 +416,7 @@ fn a_pvtu_output_keeps_the_pieces() {
         .output()
         .unwrap();
     assert!(o.status.success());
-    assert_eq!(parafront_io::read_mesh(&vol).unwrap().tets.len(), said);
+    assert_eq!(parafront_io::read_mesh(&vol).unwrap().tets.len(), said0);
 }
 
 /// An extreme needle (a 6-sided frustum, triangles 2500 times longer than

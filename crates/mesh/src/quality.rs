@@ -375,7 +375,62 @@ impl Acc {
     }
 }
 
+impl Stat {
+    /// Both measures' values together (`count`-weighted mean).
+    pub fn merge(&self, o: &Stat) -> Stat {
+        match (self.count, o.count) {
+            (0, _) => *o,
+            (_, 0) => *self,
+            (a, b) => Stat {
+                min: self.min.min(o.min),
+                max: self.max.max(o.max),
+                mean: (self.mean * a as f64 + o.mean * b as f64) / (a + b) as f64,
+                count: a + b,
+            },
+        }
+    }
+}
+
 impl QualityReport {
+    /// The report of two meshes' tets together (pieces of one mesh, §8):
+    /// counts and histograms add, means weigh by their counts. The edge
+    /// measure stays only when both have it (a shared edge counts once
+    /// per piece).
+    pub fn merge(&self, o: &QualityReport) -> QualityReport {
+        let small = |r: &QualityReport| {
+            (r.share_min_dihedral_below * (r.n_tets - r.n_skipped) as f64).round()
+        };
+        let measured = (self.n_tets - self.n_skipped) + (o.n_tets - o.n_skipped);
+        let both = |a: &Option<Stat>, b: &Option<Stat>| match (a, b) {
+            (Some(a), Some(b)) => Some(a.merge(b)),
+            _ => None,
+        };
+        QualityReport {
+            n_tets: self.n_tets + o.n_tets,
+            n_inverted: self.n_inverted + o.n_inverted,
+            n_skipped: self.n_skipped + o.n_skipped,
+            min_dihedral: self.min_dihedral.merge(&o.min_dihedral),
+            max_dihedral: self.max_dihedral.merge(&o.max_dihedral),
+            radius_ratio: self.radius_ratio.merge(&o.radius_ratio),
+            mean_ratio: self.mean_ratio.merge(&o.mean_ratio),
+            dihedral_hist: self.dihedral_hist.clone().merge(&o.dihedral_hist),
+            min_dihedral_hist: self.min_dihedral_hist.clone().merge(&o.min_dihedral_hist),
+            max_dihedral_hist: self.max_dihedral_hist.clone().merge(&o.max_dihedral_hist),
+            radius_ratio_hist: self.radius_ratio_hist.clone().merge(&o.radius_ratio_hist),
+            mean_ratio_hist: self.mean_ratio_hist.clone().merge(&o.mean_ratio_hist),
+            share_min_dihedral_below: if measured == 0 {
+                0.0
+            } else {
+                (small(self) + small(o)) / measured as f64
+            },
+            edge_ratio: both(&self.edge_ratio, &o.edge_ratio),
+            edge_ratio_hist: match (&self.edge_ratio_hist, &o.edge_ratio_hist) {
+                (Some(a), Some(b)) => Some(a.clone().merge(b)),
+                _ => None,
+            },
+        }
+    }
+
     /// Shape quality of every tet (no edge-length measure).
     pub fn new(mesh: &TetMesh) -> QualityReport {
         Self::compute(mesh, None::<fn(P3) -> f64>)

@@ -172,3 +172,36 @@ fn histogram_binning() {
     assert_eq!(c.total(), 8);
     assert!((c.bin_width() - 0.15).abs() < 1e-12);
 }
+
+#[test]
+fn merged_reports_of_two_halves_are_the_whole() {
+    let m = box_mesh(4, 3, 2, [0.0; 3], [2.0, 1.5, 1.0]);
+    let half = |keep: bool| TetMesh {
+        points: m.points.clone(),
+        tets: m
+            .tets
+            .iter()
+            .filter(|t| (m.points[t[0].idx()][0] < 1.0) == keep)
+            .copied()
+            .collect(),
+        ..Default::default()
+    };
+    let size = |_: P3| 0.5;
+    let whole = QualityReport::with_size(&m, size);
+    let (a, b) = (
+        QualityReport::with_size(&half(true), size),
+        QualityReport::with_size(&half(false), size),
+    );
+    assert!(a.n_tets > 0 && b.n_tets > 0);
+    let g = a.merge(&b);
+    assert_eq!(g.n_tets, whole.n_tets);
+    assert_eq!(g.min_dihedral.min, whole.min_dihedral.min);
+    assert_eq!(g.max_dihedral.max, whole.max_dihedral.max);
+    assert_eq!(g.radius_ratio.count, whole.radius_ratio.count);
+    assert!((g.mean_ratio.mean - whole.mean_ratio.mean).abs() < 1e-12);
+    assert_eq!(g.dihedral_hist, whole.dihedral_hist);
+    assert_eq!(g.min_dihedral_hist, whole.min_dihedral_hist);
+    assert_eq!(g.share_min_dihedral_below, whole.share_min_dihedral_below);
+    // Edges on the cut count in both halves.
+    assert!(g.edge_ratio.unwrap().count >= whole.edge_ratio.unwrap().count);
+}

@@ -30,7 +30,7 @@ use serial::*;
 pub use check::{check_pieces, PieceCheck, PieceCheckError};
 pub use ddg_build::{build_ddg, DdgBuildStats};
 pub use parafront_ddg::Partition;
-pub use redistribute::Piece;
+pub use redistribute::{shift_pieces, Piece};
 
 use parafront_comm::{Comm, Wire, WireError};
 use parafront_ddg::{self as ddg, Ddg, Interfaces, Locator, PartFilter, Shift};

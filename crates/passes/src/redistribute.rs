@@ -139,6 +139,59 @@ pub(crate) fn run<C: Comm>(
     })
 }
 
+/// §9.5's shift between two improvement passes on the pieces: every tet
+/// with a point that a lower piece shares goes to the lowest such piece,
+/// so that the former cuts lie inside a piece; the pieces are rebuilt
+/// (points once by exact key, in order of use), their tets numbered again
+/// and their shared lists found again. Global point ids stay.
+pub fn shift_pieces<C: Comm>(comm: &C, pieces: Vec<Piece>) -> Result<Vec<Piece>, PassError> {
+    let start = comm.owned().start;
+    let out: Vec<Vec<(u32, Batch)>> = pieces
+        .into_par_iter()
+        .enumerate()
+        .map(|(i, pc)| {
+            let k = (start + i) as u32;
+            let mut low = vec![k; pc.points.len()];
+            for (&q, list) in pc.neighbours.iter().zip(&pc.shared) {
+                for &j in list {
+                    low[j as usize] = low[j as usize].min(q);
+                }
+            }
+            let dst: Vec<u32> = pc
+                .tets
+                .iter()
+                .map(|t| t.iter().map(|&j| low[j as usize]).min().unwrap_or(k))
+                .collect();
+            let mut order: Vec<u32> = (0..pc.tets.len() as u32).collect();
+            order.sort_by_key(|&t| dst[t as usize]);
+            let mut stamp = vec![u32::MAX; pc.points.len()];
+            let mut out = Vec::new();
+            for group in order.chunk_by(|&a, &b| dst[a as usize] == dst[b as usize]) {
+                let d = dst[group[0] as usize];
+                let mut b = Batch::default();
+                for &t in group {
+                    let tv = pc.tets[t as usize];
+                    for &p in &tv {
+                        if stamp[p as usize] != d {
+                            stamp[p as usize] = d;
+                            b.points.push((pc.gid[p as usize], pc.points[p as usize]));
+                        }
+                    }
+                    b.tets.push(tv.map(|p| pc.gid[p as usize]));
+                    b.pass.push(pc.tet_pass[t as usize]);
+                }
+                out.push((d, b));
+            }
+            out
+        })
+        .collect();
+    let inbox = comm.exchange(out);
+    let mut pieces = agreed(comm, receive_tets(inbox))?;
+    number_tets(comm, &mut pieces);
+    share_points(comm, &mut pieces);
+    Ok(pieces.into_iter().map(|p| p.0).collect())
+}
+
 /// `r` once every process knows whether each succeeded: an error here
 /// is returned as it is, one elsewhere as [`PassError::Remote`] (a run
 /// stopper: these are no front failures).

@@ -7,6 +7,7 @@
 
 mod lattice;
 mod parts;
+mod pieces;
 use parts::{finish_pieces, holds_part0, mesh_parts};
 mod regions;
 mod summary;
@@ -306,12 +307,6 @@ fn mesh_surface_here<C: Comm>(
         if opts.parts < 2 {
             return Err(MeshError::Partitioned("it needs parts > 1".into()));
         }
-        if opts.optimize > 0 {
-            return Err(MeshError::Partitioned(
-                "it is the mesh as the parallel passes left it: improvement (optimize) must be 0"
-                    .into(),
-            ));
-        }
         // The lattice's tets would be in no piece.
         pieces_only = MeshOptions {
             lattice: LatticeMode::Off,
@@ -377,7 +372,7 @@ fn mesh_surface_here<C: Comm>(
             mesh_parallel_around,
         )?;
         if !opts.gather {
-            return finish_pieces(s, &fronts, opts, comm, sum).map(Some);
+            return finish_pieces(s, &fronts, &sizing, opts, comm, sum).map(Some);
         }
         if !holds_part0(comm) {
             return Ok(None);

@@ -167,15 +167,30 @@ type ParallelMesher<C> = fn(
     &C,
 ) -> Result<ParOutput, PassError>;
 
-/// The end of a partitioned run (`gather` off): the pieces checked where
-/// they lie, the counts summed over the processes; the mesh is empty.
+/// The end of a partitioned run (`gather` off): the pieces improved,
+/// checked and measured where they lie, the counts summed over the
+/// processes; the mesh is empty.
 pub(crate) fn finish_pieces<C: Comm>(
     s: &Surface,
     fronts: &[RegionFront],
+    sizing: &Sizing,
     opts: &MeshOptions,
     comm: &C,
     mut sum: Summary,
 ) -> Result<(TetMesh, Summary), MeshError> {
+    if opts.optimize > 0 {
+        let t0 = Instant::now();
+        let region: Vec<u32> = fronts.iter().map(|rf| rf.region_id).collect();
+        let io = parafront_improve::ImproveOptions {
+            level: opts.optimize,
+            parts: opts.optimize_parts,
+        };
+        let (st, n) =
+            crate::pieces::improve_pieces(comm, &mut sum.pieces, &region, s.points.len(), &io)?;
+        sum.improve = Some(st);
+        sum.points = n;
+        sum.push(Stage::Improve, t0.elapsed().as_secs_f64());
+    }
     let t0 = Instant::now();
     // Region by region, one piece per part held here.
     let held = comm.owned().len();
@@ -210,6 +225,11 @@ pub(crate) fn finish_pieces<C: Comm>(
     drop(by_part);
     sum.push(Stage::Check, t0.elapsed().as_secs_f64());
     sum.tets = tets;
+    if !opts.no_quality {
+        let t0 = Instant::now();
+        sum.quality = crate::pieces::pieces_quality(comm, &sum.pieces, &|p| sizing.size(p));
+        sum.push(Stage::Quality, t0.elapsed().as_secs_f64());
+    }
     sum.regions = fronts.len();
     Ok((TetMesh::default(), sum))
 }
