@@ -18,6 +18,15 @@ pub(crate) fn launched() -> bool {
         .any(|n| n > 1)
 }
 
+/// Rank 0 says why a run failed; the others exit with its code, silently.
+fn quiet(rank: usize, f: Fail) -> Fail {
+    if rank == 0 {
+        f
+    } else {
+        Fail(f.0, String::new())
+    }
+}
+
 /// MPI for this process, one part until the run says how many.
 pub(crate) fn start() -> Result<Mpi, Fail> {
     Mpi::init(1).map_err(|e| Fail(2, format!("MPI: {e}")))
@@ -34,13 +43,7 @@ pub(crate) fn run_mesh(
     w: &WriteArgs,
 ) -> Result<(), Fail> {
     let (rank, ranks) = (mpi.rank(), mpi.ranks());
-    let quiet = |f: Fail| {
-        if rank == 0 {
-            f
-        } else {
-            Fail(f.0, String::new())
-        }
-    };
+    let quiet = |f: Fail| quiet(rank, f);
     if a.parts < ranks {
         return Err(quiet(Fail(
             2,
@@ -85,13 +88,7 @@ pub(crate) fn run_bench(
     ddg_passes: Option<usize>,
 ) -> Result<(), Fail> {
     let (rank, ranks) = (mpi.rank(), mpi.ranks());
-    let quiet = |f: Fail| {
-        if rank == 0 {
-            f
-        } else {
-            Fail(f.0, String::new())
-        }
-    };
+    let quiet = |f: Fail| quiet(rank, f);
     if let Some(&p) = parts.iter().find(|&&p| p < ranks) {
         return Err(quiet(Fail(
             2,

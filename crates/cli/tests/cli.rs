@@ -380,7 +380,8 @@ fn a_pvtu_output_keeps_the_pieces() {
         for (k, n) in names.iter().enumerate() {
             let piece = parafront_io::read_mesh(&pv.parent().unwrap().join(n)).unwrap();
             // Pieces go region by region, four each.
-            m.region.extend(std::iter::repeat_n(k as u32 / 4, piece.tets.len()));
+            m.region
+                .extend(std::iter::repeat_n(k as u32 / 4, piece.tets.len()));
             let local: Vec<u32> = piece
                 .points
                 .iter()

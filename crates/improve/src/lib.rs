@@ -133,6 +133,24 @@ pub struct ImproveStats {
 }
 
 impl ImproveStats {
+    /// Adds `b`'s operation counts and seconds (the parts of one run).
+    pub fn add_ops(&mut self, b: &ImproveStats) {
+        for (x, y) in [
+            (&mut self.swap, b.swap),
+            (&mut self.collapse, b.collapse),
+            (&mut self.smooth, b.smooth),
+            (&mut self.selective, b.selective),
+            (&mut self.insert, b.insert),
+        ] {
+            x.tried += y.tried;
+            x.done += y.done;
+            x.seconds += y.seconds;
+        }
+        self.swaps_23 += b.swaps_23;
+        self.swaps_32 += b.swaps_32;
+        self.edge_removals += b.edge_removals;
+    }
+
     /// (operation, stats) in a fixed order, for reports.
     pub fn ops(&self) -> [(&'static str, OpStats); 5] {
         [

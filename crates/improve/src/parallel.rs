@@ -133,23 +133,6 @@ fn cut(mesh: &TetMesh, tets: &[u32], frozen: &[bool], level: u8) -> Result<Piece
     })
 }
 
-fn add(a: &mut ImproveStats, b: &ImproveStats) {
-    for (x, y) in [
-        (&mut a.swap, b.swap),
-        (&mut a.collapse, b.collapse),
-        (&mut a.smooth, b.smooth),
-        (&mut a.selective, b.selective),
-        (&mut a.insert, b.insert),
-    ] {
-        x.tried += y.tried;
-        x.done += y.done;
-        x.seconds += y.seconds;
-    }
-    a.swaps_23 += b.swaps_23;
-    a.swaps_32 += b.swaps_32;
-    a.edge_removals += b.edge_removals;
-}
-
 /// One parallel pass over the parts given by `part`; returns the part of
 /// each tet of the new mesh.
 fn pass(
@@ -196,7 +179,7 @@ fn pass(
         );
         mesh.region.extend_from_slice(&pc.mesh.region);
         new_part.extend(std::iter::repeat_n(k as u32, pc.mesh.tets.len()));
-        add(st, &pc.st);
+        st.add_ops(&pc.st);
     }
     mesh.tets.extend_from_slice(&kept);
     mesh.region.extend_from_slice(&kept_region);

@@ -162,27 +162,7 @@ pub fn shift_pieces<C: Comm>(comm: &C, pieces: Vec<Piece>) -> Result<Vec<Piece>,
                 .iter()
                 .map(|t| t.iter().map(|&j| low[j as usize]).min().unwrap_or(k))
                 .collect();
-            let mut order: Vec<u32> = (0..pc.tets.len() as u32).collect();
-            order.sort_by_key(|&t| dst[t as usize]);
-            let mut stamp = vec![u32::MAX; pc.points.len()];
-            let mut out = Vec::new();
-            for group in order.chunk_by(|&a, &b| dst[a as usize] == dst[b as usize]) {
-                let d = dst[group[0] as usize];
-                let mut b = Batch::default();
-                for &t in group {
-                    let tv = pc.tets[t as usize];
-                    for &p in &tv {
-                        if stamp[p as usize] != d {
-                            stamp[p as usize] = d;
-                            b.points.push((pc.gid[p as usize], pc.points[p as usize]));
-                        }
-                    }
-                    b.tets.push(tv.map(|p| pc.gid[p as usize]));
-                    b.pass.push(pc.tet_pass[t as usize]);
-                }
-                out.push((d, b));
-            }
-            out
+            batches(&pc.points, &pc.gid, &pc.tets, &pc.tet_pass, &dst)
         })
         .collect();
     let inbox = comm.exchange(out);
@@ -239,30 +219,42 @@ fn send_tets(
                 })
                 .collect();
             drop(host);
-            // By destination, each in tet order (a stable sort).
-            let mut order: Vec<u32> = (0..part.tets.len() as u32).collect();
-            order.sort_by_key(|&t| dst[t as usize]);
-            let mut stamp = vec![u32::MAX; part.pts.len()];
-            let mut out = Vec::new();
-            for group in order.chunk_by(|&a, &b| dst[a as usize] == dst[b as usize]) {
-                let d = dst[group[0] as usize];
-                let mut b = Batch::default();
-                for &t in group {
-                    let tv = part.tets[t as usize];
-                    for &p in &tv {
-                        if stamp[p as usize] != d {
-                            stamp[p as usize] = d;
-                            b.points.push((part.gid[p as usize], part.pts[p as usize]));
-                        }
-                    }
-                    b.tets.push(tv.map(|p| part.gid[p as usize]));
-                    b.pass.push(part.tet_pass[t as usize]);
-                }
-                out.push((d, b));
-            }
-            out
+            batches(&part.pts, &part.gid, &part.tets, &part.tet_pass, &dst)
         })
         .collect()
+}
+
+/// The tets (local ids into `pts` and `gid`) as one batch per destination
+/// `dst[t]`, ascending, each in tet order with its points once.
+fn batches(
+    pts: &[P3],
+    gid: &[u32],
+    tets: &[[u32; 4]],
+    pass: &[u8],
+    dst: &[u32],
+) -> Vec<(u32, Batch)> {
+    // By destination, each in tet order (a stable sort).
+    let mut order: Vec<u32> = (0..tets.len() as u32).collect();
+    order.sort_by_key(|&t| dst[t as usize]);
+    let mut stamp = vec![u32::MAX; pts.len()];
+    let mut out = Vec::new();
+    for group in order.chunk_by(|&a, &b| dst[a as usize] == dst[b as usize]) {
+        let d = dst[group[0] as usize];
+        let mut b = Batch::default();
+        for &t in group {
+            let tv = tets[t as usize];
+            for &p in &tv {
+                if stamp[p as usize] != d {
+                    stamp[p as usize] = d;
+                    b.points.push((gid[p as usize], pts[p as usize]));
+                }
+            }
+            b.tets.push(tv.map(|p| gid[p as usize]));
+            b.pass.push(pass[t as usize]);
+        }
+        out.push((d, b));
+    }
+    out
 }
 
 /// Each part's received tets as a piece, its points once by exact key

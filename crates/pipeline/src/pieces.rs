@@ -202,21 +202,9 @@ fn renumber(pc: &mut Piece, d: &Improved, kept: &[u32], own_base: u32, tet_base:
     pc.tet_gid = (tet_base..tet_base + d.mesh.tets.len() as u32).collect();
 }
 
+/// Adds one piece's run to `a` (separate runs: every count adds).
 fn add_stats(a: &mut ImproveStats, b: &ImproveStats) {
-    for (x, y) in [
-        (&mut a.swap, b.swap),
-        (&mut a.collapse, b.collapse),
-        (&mut a.smooth, b.smooth),
-        (&mut a.selective, b.selective),
-        (&mut a.insert, b.insert),
-    ] {
-        x.tried += y.tried;
-        x.done += y.done;
-        x.seconds += y.seconds;
-    }
-    a.swaps_23 += b.swaps_23;
-    a.swaps_32 += b.swaps_32;
-    a.edge_removals += b.edge_removals;
+    a.add_ops(b);
     a.points_removed += b.points_removed;
     a.points_inserted += b.points_inserted;
     a.tets_before += b.tets_before;
