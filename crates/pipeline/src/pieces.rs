@@ -38,10 +38,30 @@ pub(crate) fn improve_pieces<C: Comm>(
     io: &ImproveOptions,
 ) -> Result<(ImproveStats, usize), MeshError> {
     let mut st = ImproveStats::default();
-    improve_round(comm, pieces, region, n_input, io, &mut st)?;
+    improve_round(comm, pieces, region, n_input, io, None, &mut st)?;
     // §9.5: the tets at each cut go to the lower piece, and a second round
-    // improves the former cuts.
+    // improves the former cuts: the points within a few layers of tets of
+    // them move, the rest (improved in the first round) stay.
     let held = comm.owned().len();
+    let mut cut: Vec<u32> = comm
+        .all_gather(
+            (0..held)
+                .map(|i| {
+                    let mut g: Vec<u32> = pieces
+                        .iter()
+                        .skip(i)
+                        .step_by(held.max(1))
+                        .flat_map(|pc| pc.shared.iter().flatten().map(|&j| pc.gid[j as usize]))
+                        .collect();
+                    g.sort_unstable();
+                    g.dedup();
+                    g
+                })
+                .collect(),
+        )
+        .concat();
+    cut.sort_unstable();
+    cut.dedup();
     let mut all = std::mem::take(pieces);
     for &r in region {
         let take = held.min(all.len());
@@ -53,18 +73,21 @@ pub(crate) fn improve_pieces<C: Comm>(
             })?;
         pieces.extend(moved);
     }
-    let n = improve_round(comm, pieces, region, n_input, io, &mut st)?;
+    let n = improve_round(comm, pieces, region, n_input, io, Some(&cut), &mut st)?;
     Ok((st, n))
 }
 
-/// One round: every piece improved with its boundary and cuts frozen, then
-/// the points and tets numbered again; the whole mesh's point count.
+/// One round: every piece improved with its boundary and cuts frozen (and,
+/// with `near`, every point farther than a few layers of tets from the
+/// points whose global ids it lists), then the points and tets numbered
+/// again; the whole mesh's point count.
 fn improve_round<C: Comm>(
     comm: &C,
     pieces: &mut [Piece],
     region: &[u32],
     n_input: usize,
     io: &ImproveOptions,
+    near: Option<&[u32]>,
     st: &mut ImproveStats,
 ) -> Result<usize, MeshError> {
     let held = comm.owned().len();
@@ -93,7 +116,11 @@ fn improve_round<C: Comm>(
         };
         // Faces in one tet of the piece (its boundary and its cuts) are
         // frozen by the improver itself.
-        let s = parafront_improve::improve(&mut mesh, &[], io)
+        let frozen = match near {
+            None => Vec::new(),
+            Some(ids) => far_from(pc, ids),
+        };
+        let s = parafront_improve::improve(&mut mesh, &frozen, io)
             .map_err(|source| MeshError::Improve { source })?;
         add_stats(st, &s);
         let was = mesh
@@ -167,6 +194,25 @@ fn improve_round<C: Comm>(
         pc.tet_pass = vec![0; pc.tets.len()];
     }
     Ok(total)
+}
+
+/// Per point of `pc`: farther than [`SHIFT_LAYERS`] layers of tets from
+/// every point whose global id `ids` (sorted) holds.
+///
+/// [`SHIFT_LAYERS`]: parafront_improve::parallel::SHIFT_LAYERS
+fn far_from(pc: &Piece, ids: &[u32]) -> Vec<bool> {
+    let mut near: Vec<bool> = pc.gid.iter().map(|g| ids.binary_search(g).is_ok()).collect();
+    for _ in 0..parafront_improve::parallel::SHIFT_LAYERS {
+        let now = near.clone();
+        for t in &pc.tets {
+            if t.iter().any(|&j| now[j as usize]) {
+                for &j in t {
+                    near[j as usize] = true;
+                }
+            }
+        }
+    }
+    near.into_iter().map(|x| !x).collect()
 }
 
 /// The new ids of one improved piece: its boundary points by their rank in
