@@ -5,6 +5,8 @@
     python3 scripts/bench.py --sets corpus --repeat 1 --out /tmp/b.md
     python3 scripts/bench.py --sets bench1e5 --peers gmsh-hxt --threads 1
     python3 scripts/bench.py --sets hard --threads 2 --peers gmsh-hxt,tetgen --append
+    python3 scripts/bench.py --sets bench1e6mpi --peers none --append \
+        --binary target/release/parafront   # built with --features mpi
 
 parafront is timed as a user times it: the whole `parafront mesh` process,
 default options, from start to exit (reading, meshing, improvement, checks,
@@ -72,6 +74,14 @@ SETS = {
     "bench1e6parts": [("bench/sphere_1e6.stl", ["--size", "0.037", "--parts", "2"]),
                       ("bench/torus_1e6.stl", ["--size", "0.032", "--parts", "2"])],
     "bench5e6": [(f"bench/{n}_5e6.stl", []) for n in ["sphere"]],
+    # Issue 22: the parts on 2 MPI ranks (--mpi R is bench.py's: mpirun -n R
+    # --oversubscribe --bind-to none; needs a binary built with --features
+    # mpi). The mesh is the threads run's at the same --parts.
+    # With the same runs on threads alone beside them.
+    "bench1e6mpi": [("bench/box2holes_1e6.stl", ["--parts", "8"]),
+                    ("bench/box2holes_1e6.stl", ["--parts", "8", "--mpi", "2"]),
+                    ("bench/sphere_1e6.stl", ["--size", "0.037", "--parts", "8"]),
+                    ("bench/sphere_1e6.stl", ["--size", "0.037", "--parts", "8", "--mpi", "2"])],
 }
 
 
@@ -135,8 +145,15 @@ def run_parafront(binary, surf, extra, threads, out_mesh):
     process's VmHWM): wait4's ru_maxrss would count the Python process the
     child was forked from."""
     cmd = [binary, "mesh", surf, "-o", out_mesh, "--threads", str(threads)] + extra
+    if "--mpi" in extra:
+        i = cmd.index("--mpi")
+        ranks = cmd[i + 1]
+        del cmd[i:i + 2]
+        cmd = ["mpirun", "-n", ranks, "--oversubscribe", "--bind-to", "none"] + cmd
+    # OpenMPI refuses root (CI, this machine) unless told.
+    env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
     t0 = time.perf_counter()
-    p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, env=env)
     wall = time.perf_counter() - t0
     r = parse_summary(p.stdout)
     r["ok"] = p.returncode == 0
@@ -215,6 +232,10 @@ def main():
                 name += " --size " + extra[extra.index("--size") + 1]
             if "--parts" in extra:
                 name += " --parts " + extra[extra.index("--parts") + 1]
+            ranks = 1
+            if "--mpi" in extra:
+                ranks = int(extra[extra.index("--mpi") + 1])
+                name += f" on {ranks} ranks"
             healed = None
             if "--heal" in extra:
                 healed = os.path.join(work, name + ".healed.stl")
@@ -230,7 +251,9 @@ def main():
                 valid = meshcheck(surf, mesh, healed)
                 wall = median([r["wall"] for r in runs])
                 tets = last.get("tets", 0)
-                rows.append([name, "parafront", t, tets, wall, tets / wall / t if wall else None,
+                # Per core: every rank runs t threads.
+                rows.append([name, "parafront", t, tets, wall,
+                             tets / wall / (t * ranks) if wall else None,
                              median([r["peak_per_tet"] for r in runs]), last.get("min_dih"),
                              last.get("pct10"), last.get("rr"),
                              "yes" if valid else "NO",
@@ -361,7 +384,7 @@ def header(L, a, started, rev, cpu):
              "prints it) over the tets.")
     L.append("- **Peers** (`../shared/tools/peers/peer_mesh.py --h auto`, each keeping the surface): "
              "their meshing call, with their own optimisation. Peak B/tet includes the Python process.")
-    L.append("- tets/s/core: tets over seconds over threads. Quality as meshcheck computes it: "
+    L.append("- tets/s/core: tets over seconds over threads (over ranks x threads on MPI rows). Quality as meshcheck computes it: "
              "worst min dihedral, share of tets with a dihedral under 10°, mean radius ratio.")
     L.append("- valid: `meshcheck.py --surface` on parafront's mesh (against the healed surface "
              "for dirty/ inputs). fill: cavities closed by the constrained fill / its tets "
