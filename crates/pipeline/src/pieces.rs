@@ -201,7 +201,11 @@ fn improve_round<C: Comm>(
 ///
 /// [`SHIFT_LAYERS`]: parafront_improve::parallel::SHIFT_LAYERS
 fn far_from(pc: &Piece, ids: &[u32]) -> Vec<bool> {
-    let mut near: Vec<bool> = pc.gid.iter().map(|g| ids.binary_search(g).is_ok()).collect();
+    let mut near: Vec<bool> = pc
+        .gid
+        .iter()
+        .map(|g| ids.binary_search(g).is_ok())
+        .collect();
     for _ in 0..parafront_improve::parallel::SHIFT_LAYERS {
         let now = near.clone();
         for t in &pc.tets {
