@@ -293,10 +293,8 @@ fn main() -> ExitCode {
                 heal,
                 write,
             } => {
-                let input = read_surface(&surface)
-                    .map_err(Fail::from)
-                    .and_then(|s| surface_cmds::heal_for_mesh(s, &heal, &write))
-                    .map(|s| (s, surface.display().to_string()));
+                let input =
+                    mesh_input(&surface, &heal, &write).map(|s| (s, surface.display().to_string()));
                 mpi_run::run_mesh(m, input, &output, &mesh, &write)
             }
             Cmd::Bench {
@@ -304,9 +302,9 @@ fn main() -> ExitCode {
                 size,
                 parts,
                 threads,
+                partition,
                 ddg_passes,
-                ..
-            } => mpi_run::run_bench(m, &surface, size, &parts, &threads, ddg_passes),
+            } => mpi_run::run_bench(m, &surface, size, &parts, &threads, &partition, ddg_passes),
             _ => Err(Fail(
                 2,
                 "under mpirun, only `mesh`, `demo` and `bench` run (over the ranks)".into(),
@@ -338,9 +336,7 @@ fn main() -> ExitCode {
             mesh,
             heal,
             write,
-        } => read_surface(&surface)
-            .map_err(Fail::from)
-            .and_then(|s| surface_cmds::heal_for_mesh(s, &heal, &write))
+        } => mesh_input(&surface, &heal, &write)
             .and_then(|s| run_mesh(&s, &surface.display().to_string(), &output, &mesh, &write)),
         Cmd::Heal {
             input,
@@ -367,6 +363,11 @@ fn main() -> ExitCode {
         } => surface_cmds::run_convert(&input, &output, &write),
     };
     exit(res)
+}
+
+/// The surface `mesh` reads: `path`, healed as `heal` says.
+fn mesh_input(path: &Path, heal: &HealArgs, w: &WriteArgs) -> Result<Surface, Fail> {
+    surface_cmds::heal_for_mesh(read_surface(path)?, heal, w)
 }
 
 /// The exit code, with the message on stderr (none when empty: an MPI

@@ -85,6 +85,7 @@ pub(crate) fn run_bench(
     size: Option<f64>,
     parts: &[usize],
     threads: &[usize],
+    methods: &[parafront_pipeline::Partition],
     ddg_passes: Option<usize>,
 ) -> Result<(), Fail> {
     let (rank, ranks) = (mpi.rank(), mpi.ranks());
@@ -117,10 +118,13 @@ pub(crate) fn run_bench(
         );
         crate::parallel::print_bench_head();
     }
-    for &p in parts {
+    for (&p, &method) in parts
+        .iter()
+        .flat_map(|p| methods.iter().map(move |m| (p, m)))
+    {
         mpi.set_parts(p);
         if rank == 0 {
-            println!("--parts {p}:");
+            println!("--parts {p}, partition {}:", method.name());
         }
         for &t in threads {
             let pool = rayon::ThreadPoolBuilder::new()
@@ -132,6 +136,7 @@ pub(crate) fn run_bench(
                 threads: t,
                 optimize: 0,
                 no_quality: true,
+                partition: method,
                 ddg_passes,
                 ..Default::default()
             };

@@ -35,6 +35,11 @@ pub trait Comm: Sync {
     /// arguments and the inboxes of [`exchange`](Comm::exchange) have one
     /// entry per owned part, in this order. The threads backend owns all.
     fn owned(&self) -> Range<usize>;
+    /// Whether this process holds part `part` (part 0 is where a run's
+    /// serial steps and gathered results live).
+    fn holds(&self, part: usize) -> bool {
+        self.owned().contains(&part)
+    }
     /// Point-to-point messages: `out[i]` lists `(dst, message)` sent by
     /// part `owned().start + i`. The answer's `[i]` is what part
     /// `owned().start + i` receives: `(src, message)` ordered by `src`,

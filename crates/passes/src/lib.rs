@@ -453,26 +453,35 @@ fn agree<C: Comm, T>(
     pass: u8,
     local: Vec<Result<T, (usize, FrontError)>>,
 ) -> Result<Vec<T>, PassError> {
-    let said: Vec<Option<String>> = comm.all_gather(
-        local
-            .iter()
-            .map(|r| r.as_ref().err().map(|(_, e)| e.to_string()))
-            .collect(),
-    );
-    let Some(part) = said.iter().position(Option::is_some) else {
+    let said = local
+        .iter()
+        .map(|r| r.as_ref().err().map(|(_, e)| e.to_string()))
+        .collect();
+    let Some((part, message)) = first_failure(comm, said) else {
         return Ok(local.into_iter().filter_map(Result::ok).collect());
     };
-    let start = comm.owned().start;
-    if comm.owned().contains(&part) {
-        if let Some(Err((_, source))) = local.into_iter().nth(part - start) {
+    if comm.holds(part) {
+        if let Some(Err((_, source))) = local.into_iter().nth(part - comm.owned().start) {
             return Err(PassError::Pass { pass, part, source });
         }
     }
     Err(PassError::Remote {
         part,
-        message: said[part].clone().unwrap_or_default(),
+        message,
         pass_failed: true,
     })
+}
+
+/// The first part, over all processes, whose entry of `said` (one per
+/// owned part: its failure's message, or none) is a failure.
+pub(crate) fn first_failure<C: Comm>(
+    comm: &C,
+    said: Vec<Option<String>>,
+) -> Option<(usize, String)> {
+    comm.all_gather(said)
+        .into_iter()
+        .enumerate()
+        .find_map(|(part, m)| m.map(|m| (part, m)))
 }
 
 /// What one part's front call gave back, before new points get global ids.
@@ -485,6 +494,15 @@ struct Made {
     /// Per face of `res.front`: stuck rather than held by the region.
     stuck: Vec<bool>,
     seconds: f64,
+}
+
+impl Made {
+    /// The points the front call made (global ids to be given).
+    fn new_points(&self) -> u32 {
+        self.res
+            .as_ref()
+            .map_or(0, |r| (r.points.len() - self.input_gid.len()) as u32)
+    }
 }
 
 /// Where the parts may mesh in one pass (§7): a conservative owner for

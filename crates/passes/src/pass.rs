@@ -75,15 +75,7 @@ pub(crate) fn parallel_pass<C: Comm>(
     let made = crate::agree(comm, pass, made)?;
 
     // Global ids for the new points: an all-gather of the counts.
-    let counts = comm.all_gather(
-        made.iter()
-            .map(|m| {
-                m.res
-                    .as_ref()
-                    .map_or(0, |r| r.points.len() - m.input_gid.len()) as u32
-            })
-            .collect(),
-    );
+    let counts = comm.all_gather(made.iter().map(Made::new_points).collect());
     let mut base = Vec::with_capacity(np);
     let mut acc = *next_gid;
     for c in &counts {
@@ -194,12 +186,7 @@ pub(crate) fn seed_inner_parts(
     size: &(dyn Fn(P3) -> f64 + Sync),
     next_gid: &mut u32,
 ) -> usize {
-    let np = part0
-        .iter()
-        .map(|&k| k as usize + 1)
-        .max()
-        .unwrap_or(0)
-        .max(owned.end);
+    let np = part0.iter().map(|&k| k as usize + 1).max().unwrap_or(0);
     let nt = d.tets.len();
     // Face steps from a wall or the surface.
     let mut depth = vec![u32::MAX; nt];

@@ -80,7 +80,7 @@ pub(crate) fn run<C: Comm>(
     let inbox = comm.exchange(send_tets(parts, comm.owned().start, loc, part0));
     // Each part: its points once, by exact key.
     let received = receive_tets(inbox).and_then(|p| match fail_part {
-        Some(part) if comm.owned().contains(&part) => Err(PassError::Injected { part }),
+        Some(part) if comm.holds(part) => Err(PassError::Injected { part }),
         _ => Ok(p),
     });
     let mut pieces = agreed(comm, received)?;
@@ -110,7 +110,7 @@ pub(crate) fn run<C: Comm>(
             })
             .collect();
         let inbox = comm.exchange(out);
-        if comm.owned().start == 0 && !comm.owned().is_empty() {
+        if comm.holds(0) {
             let got: Vec<Piece> = inbox
                 .into_iter()
                 .next()
@@ -177,13 +177,15 @@ pub fn shift_pieces<C: Comm>(comm: &C, pieces: Vec<Piece>) -> Result<Vec<Piece>,
 /// stopper: these are no front failures).
 fn agreed<C: Comm, T>(comm: &C, r: Result<T, PassError>) -> Result<T, PassError> {
     let mine = r.as_ref().err().map(|e| e.to_string());
-    let said: Vec<Option<String>> = comm.all_gather(vec![mine; comm.owned().len()]);
-    match (r, said.iter().position(Option::is_some)) {
+    match (
+        r,
+        crate::first_failure(comm, vec![mine; comm.owned().len()]),
+    ) {
         (Err(e), _) => Err(e),
         (Ok(x), None) => Ok(x),
-        (Ok(_), Some(part)) => Err(PassError::Remote {
+        (Ok(_), Some((part, message))) => Err(PassError::Remote {
             part,
-            message: said[part].clone().unwrap_or_default(),
+            message,
             pass_failed: false,
         }),
     }

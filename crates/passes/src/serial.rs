@@ -190,7 +190,7 @@ pub(super) fn serial_pass<C: Comm>(
 ) -> Result<(usize, usize), PassError> {
     let last = rounds.len() - 1;
     // Part 0's process runs the front; the others follow its choices.
-    let here = comm.owned().start == 0 && !comm.owned().is_empty();
+    let here = comm.holds(0);
     let out: Vec<Vec<(u32, [Rec; 3])>> = parts
         .iter_mut()
         .map(|p| {
@@ -247,13 +247,12 @@ pub(super) fn serial_pass<C: Comm>(
         let (code, n_new, g, message) = said.into_iter().next().unwrap_or_default();
         match (code, step) {
             (0, step) => {
-                if let Try4::Closed(m) = step {
-                    let n = absorb(&mut parts[0], *m, *next_gid, 4);
-                    *next_gid += n_new;
-                    return Ok((n, removed));
-                }
+                let n = match step {
+                    Try4::Closed(m) => absorb(&mut parts[0], *m, *next_gid, 4),
+                    _ => 0,
+                };
                 *next_gid += n_new;
-                return Ok((0, removed));
+                return Ok((n, removed));
             }
             (1, _) => {
                 around = (!g.is_empty()).then_some(g);
@@ -285,14 +284,6 @@ enum Try4 {
     Failed(FrontError),
     /// Part 0 is held by another process.
     Elsewhere,
-}
-
-impl Made {
-    fn new_points(&self) -> u32 {
-        self.res
-            .as_ref()
-            .map_or(0, |r| (r.points.len() - self.input_gid.len()) as u32)
-    }
 }
 
 /// Pass 4's front on `hole` with `rounds` of recovery; `retry`: a stuck
@@ -388,7 +379,7 @@ pub(super) fn peel_layer<C: Comm>(
         })
         .collect();
     let mut inbox = comm.exchange(out);
-    let here = comm.owned().start == 0 && !comm.owned().is_empty();
+    let here = comm.holds(0);
     let inbox = if here {
         inbox.swap_remove(0)
     } else {

@@ -8,7 +8,7 @@
 mod lattice;
 mod parts;
 mod pieces;
-use parts::{finish_pieces, holds_part0, mesh_parts};
+use parts::{finish_pieces, mesh_parts};
 mod regions;
 mod summary;
 
@@ -114,10 +114,10 @@ pub struct MeshOptions {
     pub fail_part: Option<usize>,
     /// Merge the parts into one mesh (true, the default), or leave the mesh
     /// in its pieces, on the processes that made them (false: a `.pvtu`
-    /// output, memory distributed under MPI). Off needs `parts` > 1 and
-    /// `optimize` 0 (improvement does not run on pieces yet), and turns the
-    /// lattice off (its tets are in no piece); the summary then has the
-    /// pieces, and the mesh returned is empty.
+    /// output, memory distributed under MPI). Off needs `parts` > 1, turns
+    /// the lattice off (its tets are in no piece) and improves the pieces
+    /// where they lie (§9.5); the summary then has the pieces, and the mesh
+    /// returned is empty.
     #[serde(default = "yes")]
     pub gather: bool,
 }
@@ -374,7 +374,7 @@ fn mesh_surface_here<C: Comm>(
         if !opts.gather {
             return finish_pieces(s, &fronts, &sizing, opts, comm, sum).map(Some);
         }
-        if !holds_part0(comm) {
+        if !comm.holds(0) {
             return Ok(None);
         }
         inner

@@ -18,7 +18,7 @@ pub(crate) fn mesh_parts<C: Comm>(
     comm: &C,
     parallel: ParallelMesher<C>,
 ) -> Result<Vec<u32>, MeshError> {
-    let holds = holds_part0(comm);
+    let holds = comm.holds(0);
     // Without the merged mesh, where each region's new points start.
     let mut next_base = s.points.len() as u32;
     // The lattice's inner points, for improvement to leave alone.
@@ -115,30 +115,25 @@ pub(crate) fn mesh_parts<C: Comm>(
         {
             stage[k] += x;
         }
-        if !opts.gather {
+        // Where the region's new points start in the whole mesh, for the
+        // pieces' global ids; none when there are no pieces to keep.
+        let pieces_base = if !opts.gather {
             let base = next_base;
             next_base += out.n_points - pts.len() as u32;
             sum.points = next_base as usize;
-            for mut pc in out.pieces {
-                for g in &mut pc.gid {
-                    *g = global_id(rf, base, *g);
-                }
-                sum.pieces.push(pc);
-            }
-            sum.parallel.push(out.stats);
-            continue;
-        }
-        if !holds {
-            sum.parallel.push(out.stats);
-            continue;
-        }
-        let mut tets = out.tets;
-        tets.extend(lattice.tets.iter().map(|t| t.map(|v| v + n_in)));
-        let base = append_region(mesh, rf, &out.points, &tets);
-        note_lattice(&lattice, base, sum, &mut lattice_inner);
-        // The lattice's tets are in no piece: no pieces then (`--pvtu`
-        // turns the lattice off).
-        if lattice.tets.is_empty() {
+            Some(base)
+        } else if holds {
+            let mut tets = out.tets;
+            tets.extend(lattice.tets.iter().map(|t| t.map(|v| v + n_in)));
+            let base = append_region(mesh, rf, &out.points, &tets);
+            note_lattice(&lattice, base, sum, &mut lattice_inner);
+            // The lattice's tets are in no piece: no pieces then (`--pvtu`
+            // turns the lattice off).
+            lattice.tets.is_empty().then_some(base)
+        } else {
+            None
+        };
+        if let Some(base) = pieces_base {
             for mut pc in out.pieces {
                 for g in &mut pc.gid {
                     *g = global_id(rf, base, *g);
@@ -232,11 +227,6 @@ pub(crate) fn finish_pieces<C: Comm>(
     }
     sum.regions = fronts.len();
     Ok((TetMesh::default(), sum))
-}
-
-/// This process holds part 0, where the mesh gathers.
-pub(crate) fn holds_part0<C: Comm>(comm: &C) -> bool {
-    comm.owned().start == 0 && !comm.owned().is_empty()
 }
 
 #[cfg(test)]
