@@ -533,7 +533,8 @@ pub(crate) fn run_mesh_on<C: Comm>(
     println!("wrote {}", out.display());
     if let Some(p) = &a.pvtu {
         parallel::write_partitioned(p, &sum, &wopts)?;
-        println!("wrote {} ({} pieces)", p.display(), sum.pieces.len());
+        let written = sum.pieces.iter().filter(|pc| !pc.tets.is_empty()).count();
+        println!("wrote {} ({written} pieces)", p.display());
     }
     if let (Some(p), Some(q)) = (&a.plot, &sum.quality) {
         plot::plot_histograms(q, sum.quality_before.as_ref(), p)?;
@@ -555,7 +556,20 @@ fn write_pieces<C: Comm>(
     let t0 = Instant::now();
     let held = comm.owned();
     let n = held.len();
-    let res = parallel::write_partitioned_share(out, sum, w, held);
+    // Which pieces have tets, over all processes: region by region, one
+    // flag per part.
+    let mut filled = Vec::with_capacity(sum.pieces.len() * comm.parts() / n.max(1));
+    for r in 0..sum.parallel.len() {
+        let local: Vec<u8> = (0..n)
+            .map(|i| {
+                sum.pieces
+                    .get(r * n + i)
+                    .map_or(0, |pc| u8::from(!pc.tets.is_empty()))
+            })
+            .collect();
+        filled.extend(comm.all_gather(local).into_iter().map(|f| f > 0));
+    }
+    let res = parallel::write_partitioned_share(out, sum, w, held, &filled);
     let failed = comm.all_reduce(vec![res.is_err() as u8; n], u8::max);
     let files = match res {
         Err(e) => return Err(e),
@@ -584,7 +598,7 @@ fn write_pieces<C: Comm>(
                     .join(", ")
             );
         }
-        let total = sum.parallel.first().map_or(0, |st| st.parts) * sum.parallel.len();
+        let total = filled.iter().filter(|&&f| f).count();
         println!("wrote {} ({total} pieces)", out.display());
     }
     drop(files);

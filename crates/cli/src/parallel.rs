@@ -84,16 +84,21 @@ pub fn print_parallel(sum: &Summary) {
 /// points another part owns, and the number of parts sharing each point.
 pub fn write_partitioned(path: &Path, sum: &Summary, w: &WriteOptions) -> Result<(), Fail> {
     let parts = sum.parallel.first().map_or(0, |st| st.parts);
-    write_partitioned_share(path, sum, w, 0..parts).map(|_| ())
+    let filled: Vec<bool> = sum.pieces.iter().map(|pc| !pc.tets.is_empty()).collect();
+    write_partitioned_share(path, sum, w, 0..parts, &filled).map(|_| ())
 }
 
 /// [`write_partitioned`] for the parts `held` of this process (MPI): its
-/// pieces, and the index where part 0 is held. Returns the files written.
+/// pieces, and the index where part 0 is held. `filled[r * parts + k]`:
+/// whether region r's piece of part k has tets, over all processes; an
+/// empty piece is neither written nor named (meshio cannot read a piece
+/// without cells). Returns the files written.
 pub(crate) fn write_partitioned_share(
     path: &Path,
     sum: &Summary,
     w: &WriteOptions,
     held: std::ops::Range<usize>,
+    filled: &[bool],
 ) -> Result<Vec<std::path::PathBuf>, Fail> {
     if sum.pieces.is_empty() && held.start == 0 {
         return Err(Fail(2, "--pvtu needs --parts > 1".into()));
@@ -125,6 +130,9 @@ pub(crate) fn write_partitioned_share(
     let mut arrays = Vec::with_capacity(sum.pieces.len());
     for (i, pc) in sum.pieces.iter().enumerate() {
         let (r, k) = (i / n_held, held.start + i % n_held);
+        if pc.tets.is_empty() {
+            continue;
+        }
         ids.push(r * parts + k);
         let cell_base = region_base[r];
         let mut sharers = vec![0i32; pc.points.len()];
@@ -170,8 +178,8 @@ pub(crate) fn write_partitioned_share(
         })
         .collect();
     let index = held.start == 0 && !held.is_empty();
-    let total = parts * sum.parallel.len();
-    let mut written = write_pvtu_share(path, &ids, total, index, &pieces, w)?;
+    let listed: Vec<usize> = (0..filled.len()).filter(|&i| filled[i]).collect();
+    let mut written = write_pvtu_share(path, &ids, &listed, index, &pieces, w)?;
     if index {
         written.push(path.to_path_buf());
     }

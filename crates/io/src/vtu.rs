@@ -444,11 +444,26 @@ fn vtu_bytes(
         m.points.len(),
         m.tets.len() + m.bnd_tris.len()
     )?;
-    let mut offsets = Vec::with_capacity(enc.len());
+    // The arrays in the order the document names them; their data goes in
+    // the reverse order. meshio (5.3) re-encodes compressed data array by
+    // array, looking each one up by its offset after it has rewritten the
+    // offsets of those before: in document order, a rewritten offset equal
+    // to a later array's original one would be found first.
+    let sections = [
+        Section::PointData,
+        Section::CellData,
+        Section::Points,
+        Section::Cells,
+    ];
+    let doc: Vec<usize> = sections
+        .iter()
+        .flat_map(|&sec| (0..arrs.len()).filter(move |&i| arrs[i].section == sec))
+        .collect();
+    let mut offsets = vec![0usize; enc.len()];
     let mut off = 0usize;
-    for e in enc {
-        offsets.push(off);
-        off += e.nbytes();
+    for &i in doc.iter().rev() {
+        offsets[i] = off;
+        off += enc[i].nbytes();
     }
     for (section, tag, gid) in [
         (Section::PointData, "PointData", "GlobalPointIds"),
@@ -478,8 +493,8 @@ fn vtu_bytes(
     writeln!(w, "    </Piece>\n  </UnstructuredGrid>")?;
     // meshio finds the data after the first '_' and drops from the last '\n'.
     write!(w, "  <AppendedData encoding=\"raw\">\n   _")?;
-    for e in enc {
-        e.write(w)?;
+    for &i in doc.iter().rev() {
+        enc[i].write(w)?;
     }
     writeln!(w, "\n  </AppendedData>\n</VTKFile>")?;
     Ok(())
@@ -512,18 +527,18 @@ pub fn write_pvtu(
     opts: &WriteOptions,
 ) -> Result<Vec<PathBuf>, IoError> {
     let ids: Vec<usize> = (0..parts.len()).collect();
-    write_pvtu_share(path, &ids, parts.len(), true, parts, opts)
+    write_pvtu_share(path, &ids, &ids, true, parts, opts)
 }
 
 /// [`write_pvtu`] for one process's share of a partitioned mesh (MPI):
 /// `parts[i]` is written as `<stem>_<ids[i]>.vtu`; with `index`, the index
-/// at `path` names all `total` pieces (the other processes' pieces carry
+/// at `path` names the pieces `listed` (the other processes' pieces carry
 /// the same arrays). Returns the parts' paths; on error no file of this
 /// call remains.
 pub fn write_pvtu_share(
     path: &Path,
     ids: &[usize],
-    total: usize,
+    listed: &[usize],
     index: bool,
     parts: &[Piece],
     opts: &WriteOptions,
@@ -570,7 +585,7 @@ pub fn write_pvtu_share(
         return Ok(written);
     }
     let sig = sig.unwrap_or_default();
-    let names: Vec<String> = (0..total).map(|k| format!("{stem}_{k}.vtu")).collect();
+    let names: Vec<String> = listed.iter().map(|k| format!("{stem}_{k}.vtu")).collect();
     let res = write_atomic(path, |w| {
         writeln!(w, "<?xml version=\"1.0\"?>")?;
         writeln!(
