@@ -1,6 +1,7 @@
 //! `parafront`: the command line. A thin layer: each subcommand parses its
 //! flags into the library's option structs and calls one function.
-// Not forbid: resetting SIGPIPE (in `main`) needs one unsafe call.
+// Not forbid: resetting SIGPIPE and glibc's malloc settings (in `main`)
+// need unsafe calls.
 #![deny(unsafe_code)]
 #[cfg(feature = "mpi")]
 mod mpi_run;
@@ -243,6 +244,19 @@ fn main() -> ExitCode {
     #[allow(unsafe_code)]
     unsafe {
         libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
+    #[cfg(all(target_os = "linux", target_env = "gnu"))]
+    // SAFETY: at startup, before any allocation on another thread. glibc
+    // raises its mmap threshold each time a large block is freed, up to
+    // 32 MiB; the blocks the stages free then stay in its heaps, and the
+    // next stage's, allocated on other threads (other arenas), come on top.
+    // A fixed threshold gives blocks of 256 KiB and more back when freed:
+    // the peak of sphere_5e6 drops from 297 to 256 MiB by default, and from
+    // 306 to 213 MiB at --parts 8 -o x.pvtu, at the same speed.
+    #[allow(unsafe_code)]
+    unsafe {
+        libc::mallopt(libc::M_MMAP_THRESHOLD, 256 << 10);
+        libc::mallopt(libc::M_TRIM_THRESHOLD, 256 << 10);
     }
     // Diagnostics on stderr, off unless RUST_LOG asks (e.g. RUST_LOG=debug).
     tracing_subscriber::fmt()
