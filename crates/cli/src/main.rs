@@ -413,6 +413,20 @@ pub(crate) fn write_options(w: &WriteArgs, s: Option<&Surface>) -> Result<WriteO
     })
 }
 
+/// Between stages: glibc keeps the free pages inside its heaps (the many
+/// small blocks of the size field's build, of the front and of the
+/// improvement, which the fixed thresholds in `main` do not cover) until
+/// asked to give them back.
+fn release_memory() {
+    #[cfg(all(target_os = "linux", target_env = "gnu"))]
+    // SAFETY: malloc_trim only returns free memory to the system; it is
+    // thread-safe (it locks each arena).
+    #[allow(unsafe_code)]
+    unsafe {
+        libc::malloc_trim(0);
+    }
+}
+
 fn mesh_options(a: &MeshArgs) -> Result<MeshOptions, Fail> {
     let mut o = MeshOptions::default();
     if let Some(f) = &a.size_file {
@@ -445,6 +459,7 @@ fn mesh_options(a: &MeshArgs) -> Result<MeshOptions, Fail> {
     o.serial_from = a.serial_from;
     o.ddg_cap = a.ddg_cap;
     o.fail_part = a.fail_part;
+    o.release_memory = Some(release_memory);
     if a.parts == 0 {
         return Err(Fail(2, "--parts must be at least 1".into()));
     }

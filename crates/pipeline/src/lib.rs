@@ -120,6 +120,20 @@ pub struct MeshOptions {
     /// returned is empty.
     #[serde(default = "yes")]
     pub gather: bool,
+    /// Called after each stage that frees much (the size field's build, the
+    /// front or the passes, improvement), to hand freed memory back to the
+    /// system: the cli passes glibc's `malloc_trim`. None by default.
+    #[serde(skip)]
+    pub release_memory: Option<fn()>,
+}
+
+impl MeshOptions {
+    /// Hands freed memory back, where [`MeshOptions::release_memory`] says how.
+    pub(crate) fn release(&self) {
+        if let Some(f) = self.release_memory {
+            f();
+        }
+    }
 }
 
 fn yes() -> bool {
@@ -169,6 +183,7 @@ impl Default for MeshOptions {
             ddg_cap: default_ddg_cap(),
             fail_part: None,
             gather: true,
+            release_memory: None,
         }
     }
 }
@@ -357,6 +372,7 @@ fn mesh_surface_here<C: Comm>(
     let t0 = Instant::now();
     let sizing = Sizing::build(s, &opts.size, None)?;
     sum.push(Stage::SizeField, t0.elapsed().as_secs_f64());
+    opts.release();
 
     let t0 = Instant::now();
     let mut mesh = surface_mesh(s);
@@ -371,6 +387,7 @@ fn mesh_surface_here<C: Comm>(
             comm,
             mesh_parallel_around,
         )?;
+        opts.release();
         if !opts.gather {
             return finish_pieces(s, &fronts, &sizing, opts, comm, sum).map(Some);
         }
@@ -385,6 +402,7 @@ fn mesh_surface_here<C: Comm>(
         sum.push(Stage::Front, t0.elapsed().as_secs_f64() - lat);
         inner
     };
+    opts.release();
 
     if opts.optimize > 0 {
         // The report before improvement is the improvement's cost.
@@ -403,6 +421,7 @@ fn mesh_surface_here<C: Comm>(
         // The pieces number the mesh before improvement, which swaps and
         // collapses have changed: none is better than a stale one.
         sum.pieces.clear();
+        opts.release();
     }
 
     let t0 = Instant::now();

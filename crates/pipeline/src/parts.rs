@@ -185,6 +185,7 @@ pub(crate) fn finish_pieces<C: Comm>(
         sum.improve = Some(st);
         sum.points = n;
         sum.push(Stage::Improve, t0.elapsed().as_secs_f64());
+        opts.release();
     }
     let t0 = Instant::now();
     // Region by region, one piece per part held here.
