@@ -461,6 +461,12 @@ impl Search {
                 }
                 n_ok += 1;
                 let helps = hard.iter().filter(|&&g| with.valid(g, v)).count();
+                // Scores compare by `helps` first: a point that helps fewer
+                // faces than the best so far cannot win (and its kills, a
+                // pass over the whole front, need not be counted).
+                if best.is_some_and(|(b, _)| helps < b.0) {
+                    continue;
+                }
                 let sees = around.iter().filter(|&&g| with.valid(g, v)).count();
                 // Faces the point would leave with no apex: each tet they
                 // had holds it, and it is not one of theirs.
