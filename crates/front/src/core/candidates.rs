@@ -227,9 +227,10 @@ impl<'a> Front<'a> {
             match self.tet_is_free(v, q, pq, near_f, near_p, cl) {
                 Verdict::Free(matched) => return Some((q, pq, matched)),
                 // The face that blocked this candidate likely blocks the
-                // next one too: it is checked first (the verdict does not
+                // next one too, and the ones before it the next after: it
+                // goes first, the others one down (the verdict does not
                 // depend on the order).
-                Verdict::Face(i) => near_f.swap(0, i),
+                Verdict::Face(i) => near_f[..=i].rotate_right(1),
                 Verdict::Point => {}
             }
         }
