@@ -425,8 +425,13 @@ fn mesh_surface_here<C: Comm>(
     }
 
     let t0 = Instant::now();
-    mesh.build_adjacency()
-        .map_err(|source| MeshError::Adjacency { source })?;
+    // Improvement keeps the adjacency up to date; the check below compares
+    // every entry with its own face table, so a complete one is not built
+    // again (0.12 of 0.30 s at sphere_1e6 on one thread).
+    if opts.no_check || mesh.neigh.len() != 4 * mesh.tets.len() {
+        mesh.build_adjacency()
+            .map_err(|source| MeshError::Adjacency { source })?;
+    }
     if !opts.no_check {
         mesh.check_against_surface(&s.tris)?;
         // Exactly positive is not enough: a solver computes volumes in
