@@ -35,6 +35,9 @@ pub struct FillOptions {
     pub max_steiner_faces: usize,
     /// Steps the search (the fill's second method) may take per try.
     pub search_nodes: usize,
+    /// Steiner points the search may add (it may add `max_steiner` and one
+    /// per eight faces, up to this).
+    pub max_search_steiner: usize,
     /// Cavities with more faces are not searched.
     pub max_search_faces: usize,
     /// Points the conforming fill may put on the cavity's edges (each
@@ -54,6 +57,7 @@ impl Default for FillOptions {
             attempts: 0,
             max_steiner_faces: 200,
             search_nodes: 4000,
+            max_search_steiner: 20,
             max_search_faces: 400,
             max_split: 4096,
             max_conform_missing: 32,
@@ -156,7 +160,10 @@ pub fn fill_cavity(
         // A face in eight: each Steiner point costs a selection and a
         // search, so half the faces made the slot's failing fills 3 s
         // longer and closed no more.
-        let steiner = opts.max_steiner + faces.len() / 8;
+        // At most `max_search_steiner` in all: closed searches used up to
+        // 17 (idler_riser's 54-face cavity), failing ones spent 26 (round's
+        // 86 faces, 0.33 s).
+        let steiner = (opts.max_steiner + faces.len() / 8).min(opts.max_search_steiner);
         let search = |lp: &[P3], lf: &[[u32; 3]]| search_fill(lp, lf, opts.search_nodes, steiner);
         if let Some((steiner, tets)) = in_local_ids(points, faces, &local, search) {
             return Ok(Fill {
