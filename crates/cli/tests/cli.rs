@@ -1,4 +1,6 @@
 //! The binary end to end: exit codes and what it writes.
+mod common;
+use common::{have_meshio, meshcheck, tets_said};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -121,29 +123,6 @@ fn convert_round_trips_a_box_mesh_through_every_format() {
     let o = bin().arg("quality").arg(&src).output().unwrap();
     assert!(o.status.success());
     assert!(String::from_utf8_lossy(&o.stdout).contains("dihedral"));
-}
-
-/// `../shared/tools/meshcheck.py --surface` passes on `vol`, when the tool
-/// and python3 with numpy and meshio are there.
-fn meshcheck(vol: &Path, surf: &Path) {
-    let tool = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/tools/meshcheck.py");
-    let ok = Command::new("python3")
-        .args(["-c", "import numpy, meshio"])
-        .status()
-        .map(|s| s.success())
-        .unwrap_or(false);
-    if !tool.exists() || !ok {
-        eprintln!("meshcheck skipped: meshcheck.py or python3 with numpy+meshio not available");
-        return;
-    }
-    let o = Command::new("python3")
-        .arg(&tool)
-        .arg(vol)
-        .arg("--surface")
-        .arg(surf)
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stdout));
 }
 
 #[test]
@@ -342,12 +321,7 @@ fn parts_write_a_partitioned_mesh() {
 /// meshio 5.3 mixed up when the data went in document order.
 #[test]
 fn meshio_reads_every_piece() {
-    let ok = Command::new("python3")
-        .args(["-c", "import numpy, meshio"])
-        .status()
-        .map(|s| s.success())
-        .unwrap_or(false);
-    if !ok {
+    if !have_meshio() {
         eprintln!("skipped: python3 with numpy+meshio not available");
         return;
     }
@@ -359,12 +333,7 @@ fn meshio_reads_every_piece() {
         .unwrap();
     let text = String::from_utf8_lossy(&o.stdout).to_string();
     assert!(o.status.success(), "{text}");
-    let said: usize = text
-        .lines()
-        .find_map(|l| l.strip_suffix(" regions"))
-        .and_then(|l| l.split(' ').next())
-        .and_then(|n| n.parse().ok())
-        .expect("the tet count");
+    let said = tets_said(&text);
     let script = r#"
 import sys, re, os, meshio
 index = open(sys.argv[1]).read()
@@ -406,12 +375,7 @@ fn a_pvtu_output_keeps_the_pieces() {
             "{text}{}",
             String::from_utf8_lossy(&o.stderr)
         );
-        let said: usize = text
-            .lines()
-            .find_map(|l| l.strip_suffix(" regions"))
-            .and_then(|l| l.split(' ').next())
-            .and_then(|n| n.parse().ok())
-            .expect("the tet count");
+        let said = tets_said(&text);
         let index = std::fs::read_to_string(pv).unwrap();
         let names: Vec<&str> = index
             .split("Source=\"")

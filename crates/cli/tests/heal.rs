@@ -1,6 +1,8 @@
 //! `--heal`, `heal`, the hint in `check`, surface `convert`, and the
 //! message for a file without triangles, end to end. The corpus tests run
 //! when PARAFRONT_GEOMETRY is set.
+mod common;
+use common::meshcheck;
 use parafront_io::{write_surface, WriteOptions};
 use parafront_surface::generate::{icosphere, voxels};
 use parafront_surface::read::read_surface;
@@ -54,27 +56,6 @@ fn dirty(s: &Surface) -> Surface {
         }
     }
     d
-}
-
-fn meshcheck(vol: &Path, surf: &Path) {
-    let tool = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/tools/meshcheck.py");
-    let ok = Command::new("python3")
-        .args(["-c", "import numpy, meshio"])
-        .status()
-        .map(|s| s.success())
-        .unwrap_or(false);
-    if !tool.exists() || !ok {
-        eprintln!("meshcheck skipped: meshcheck.py or python3 with numpy+meshio not available");
-        return;
-    }
-    let o = Command::new("python3")
-        .arg(&tool)
-        .arg(vol)
-        .arg("--surface")
-        .arg(surf)
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stdout));
 }
 
 #[test]

@@ -4,6 +4,9 @@
 //! on the PATH (`PARAFRONT_MPIRUN` names another launcher).
 #![cfg(feature = "mpi")]
 
+mod common;
+use common::tets_said;
+
 use parafront_io::{read_mesh, write_surface, WriteOptions};
 use parafront_surface::generate;
 use std::io::Read;
@@ -86,15 +89,6 @@ fn run(ranks: usize, args: &[&str], limit: Duration) -> Run {
         out: out.join().unwrap(),
         err: err.join().unwrap(),
     }
-}
-
-/// The tet count of the summary's "N tets, ..." line.
-fn tets_said(out: &str) -> usize {
-    out.lines()
-        .find_map(|l| l.strip_suffix(" region").or(l.strip_suffix(" regions")))
-        .and_then(|l| l.split(' ').next())
-        .and_then(|n| n.parse().ok())
-        .unwrap_or_else(|| panic!("no tet count in\n{out}"))
 }
 
 /// Threads, then 2 and 4 ranks, on `args` (an output path is added): the

@@ -1,0 +1,41 @@
+//! Helpers shared by the binary's test files.
+#![allow(dead_code)] // each test file uses its own share
+
+use std::path::Path;
+use std::process::Command;
+
+/// Whether python3 with numpy and meshio is there.
+pub fn have_meshio() -> bool {
+    Command::new("python3")
+        .args(["-c", "import numpy, meshio"])
+        .status()
+        .map(|s| s.success())
+        .unwrap_or(false)
+}
+
+/// `../shared/tools/meshcheck.py --surface` passes on `vol`, when the tool
+/// and python3 with numpy and meshio are there.
+pub fn meshcheck(vol: &Path, surf: &Path) {
+    let tool = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/tools/meshcheck.py");
+    if !tool.exists() || !have_meshio() {
+        eprintln!("meshcheck skipped: meshcheck.py or python3 with numpy+meshio not available");
+        return;
+    }
+    let o = Command::new("python3")
+        .arg(&tool)
+        .arg(vol)
+        .arg("--surface")
+        .arg(surf)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stdout));
+}
+
+/// The tet count of a run's summary ("N tets, M points, K region(s)").
+pub fn tets_said(out: &str) -> usize {
+    out.lines()
+        .find_map(|l| l.strip_suffix(" region").or(l.strip_suffix(" regions")))
+        .and_then(|l| l.split(' ').next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("no tet count in\n{out}"))
+}
