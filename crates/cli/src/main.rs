@@ -561,8 +561,7 @@ pub(crate) fn run_mesh_on<C: Comm>(
     parallel::print_parallel(&sum);
     println!("wrote {}", out.display());
     if let Some(p) = &a.pvtu {
-        parallel::write_partitioned(p, &sum, &wopts)?;
-        let written = sum.pieces.iter().filter(|pc| !pc.tets.is_empty()).count();
+        let written = parallel::write_partitioned(p, &sum, &wopts)?;
         println!("wrote {} ({written} pieces)", p.display());
     }
     if let (Some(p), Some(q)) = (&a.plot, &sum.quality) {

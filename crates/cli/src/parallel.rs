@@ -82,10 +82,12 @@ pub fn print_parallel(sum: &Summary) {
 /// The partitioned mesh: a `.pvtu` and one `.vtu` per piece, with global
 /// point and cell ids, the owning part of each point, a ghost flag on the
 /// points another part owns, and the number of parts sharing each point.
-pub fn write_partitioned(path: &Path, sum: &Summary, w: &WriteOptions) -> Result<(), Fail> {
+/// Returns the number of pieces written (empty ones are left out).
+pub fn write_partitioned(path: &Path, sum: &Summary, w: &WriteOptions) -> Result<usize, Fail> {
     let parts = sum.parallel.first().map_or(0, |st| st.parts);
     let filled: Vec<bool> = sum.pieces.iter().map(|pc| !pc.tets.is_empty()).collect();
-    write_partitioned_share(path, sum, w, 0..parts, &filled).map(|_| ())
+    write_partitioned_share(path, sum, w, 0..parts, &filled)?;
+    Ok(filled.iter().filter(|&&f| f).count())
 }
 
 /// [`write_partitioned`] for the parts `held` of this process (MPI): its

@@ -422,6 +422,15 @@ fn ncomp_attr(n: usize) -> String {
     }
 }
 
+/// A piece's sections in document order: tag, and the array that holds
+/// the global ids when there is one.
+const PIECE_SECTIONS: [(Section, &str, &str); 4] = [
+    (Section::PointData, "PointData", "GlobalPointIds"),
+    (Section::CellData, "CellData", "GlobalCellIds"),
+    (Section::Points, "Points", ""),
+    (Section::Cells, "Cells", ""),
+];
+
 fn vtu_bytes(
     w: &mut impl Write,
     m: &TetMesh,
@@ -449,15 +458,9 @@ fn vtu_bytes(
     // array, looking each one up by its offset after it has rewritten the
     // offsets of those before: in document order, a rewritten offset equal
     // to a later array's original one would be found first.
-    let sections = [
-        Section::PointData,
-        Section::CellData,
-        Section::Points,
-        Section::Cells,
-    ];
-    let doc: Vec<usize> = sections
+    let doc: Vec<usize> = PIECE_SECTIONS
         .iter()
-        .flat_map(|&sec| (0..arrs.len()).filter(move |&i| arrs[i].section == sec))
+        .flat_map(|&(sec, _, _)| (0..arrs.len()).filter(move |&i| arrs[i].section == sec))
         .collect();
     let mut offsets = vec![0usize; enc.len()];
     let mut off = 0usize;
@@ -465,12 +468,7 @@ fn vtu_bytes(
         offsets[i] = off;
         off += enc[i].nbytes();
     }
-    for (section, tag, gid) in [
-        (Section::PointData, "PointData", "GlobalPointIds"),
-        (Section::CellData, "CellData", "GlobalCellIds"),
-        (Section::Points, "Points", ""),
-        (Section::Cells, "Cells", ""),
-    ] {
+    for (section, tag, gid) in PIECE_SECTIONS {
         write!(w, "      <{tag}")?;
         if !gid.is_empty() && arrs.iter().any(|a| a.section == section && a.name == gid) {
             write!(w, " GlobalIds=\"{gid}\"")?;
