@@ -125,6 +125,8 @@ fn cut(mesh: &TetMesh, tets: &[u32], frozen: &[bool], level: u8) -> Result<Piece
         .collect();
     let mut st = ImproveStats::default();
     let dead = run(&mut sub, &fr, level, &mut st, false, false)?;
+    // Every part is held until all are done: the merge needs no adjacency.
+    sub.neigh = Vec::new();
     Ok(Piece {
         global,
         mesh: sub,
@@ -144,6 +146,8 @@ fn pass(
     dead: &mut [bool],
     st: &mut ImproveStats,
 ) -> Result<Vec<u32>, TopoError> {
+    // Rebuilt after the passes.
+    mesh.neigh = Vec::new();
     let mut groups: Vec<Vec<u32>> = vec![Vec::new(); parts];
     let mut keep: Vec<u32> = Vec::new();
     for (t, &p) in part.iter().enumerate() {

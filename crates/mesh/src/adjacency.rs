@@ -87,10 +87,9 @@ impl TetMesh {
                 .map(|i| FaceRef::from_raw(i as u32))
                 .collect();
         }
-        let keys = face_keys(&self.tets);
-        let mut out: Vec<FaceRef> = group_chunks(&keys)
-            .par_iter()
-            .flat_map_iter(|chunk| {
+        let mut out: Vec<FaceRef> = Vec::new();
+        for_each_key_slice(&self.tets, |keys, _| {
+            out.par_extend(group_chunks(keys).par_iter().flat_map_iter(|chunk| {
                 let mut v = Vec::new();
                 for_each_group(chunk, |g| {
                     if g.len() == 1 {
@@ -98,8 +97,8 @@ impl TetMesh {
                     }
                 });
                 v
-            })
-            .collect();
+            }));
+        });
         out.par_sort_unstable();
         out
     }
@@ -142,49 +141,54 @@ pub fn face_neighbours(tets: &[[PointId; 4]]) -> Result<Vec<FaceRef>, TopoError>
             verts,
         });
     }
-    let keys = face_keys(tets);
     let neigh: Vec<AtomicU32> = (0..4 * n)
         .into_par_iter()
         .map(|_| AtomicU32::new(NO_FACE.raw()))
         .collect();
     let bad = AtomicUsize::new(0);
-    // First bad group of each chunk; chunks are in key order, so the
-    // reported one is the same on every run.
-    let first_bad: Option<TopoError> = group_chunks(&keys)
-        .par_iter()
-        .map(|chunk| {
-            let mut first = None;
-            for_each_group(chunk, |g| match g.len() {
-                1 => {}
-                2 => {
-                    let (a, b) = (low(g[0]), low(g[1]));
-                    if face_parity(tets, a) == face_parity(tets, b) {
+    // First bad group of each chunk; slices and their chunks are in key
+    // order, so the reported one is the same on every run.
+    let mut first_bad: Option<TopoError> = None;
+    for_each_key_slice(tets, |keys, _| {
+        let first = group_chunks(keys)
+            .par_iter()
+            .map(|chunk| {
+                let mut first = None;
+                for_each_group(chunk, |g| match g.len() {
+                    1 => {}
+                    2 => {
+                        let (a, b) = (low(g[0]), low(g[1]));
+                        if face_parity(tets, a) == face_parity(tets, b) {
+                            bad.fetch_add(1, Relaxed);
+                            first.get_or_insert_with(|| TopoError::FaceSameSide {
+                                face: unpack_triple(g[0]).map(PointId::from_raw),
+                                tets: [FaceRef::from_raw(a).tet(), FaceRef::from_raw(b).tet()],
+                                more: 0,
+                            });
+                        } else {
+                            neigh[a as usize].store(b, Relaxed);
+                            neigh[b as usize].store(a, Relaxed);
+                        }
+                    }
+                    _ => {
                         bad.fetch_add(1, Relaxed);
-                        first.get_or_insert_with(|| TopoError::FaceSameSide {
+                        first.get_or_insert_with(|| TopoError::FaceInManyTets {
                             face: unpack_triple(g[0]).map(PointId::from_raw),
-                            tets: [FaceRef::from_raw(a).tet(), FaceRef::from_raw(b).tet()],
+                            tets: g.iter().map(|&k| FaceRef::from_raw(low(k)).tet()).collect(),
                             more: 0,
                         });
-                    } else {
-                        neigh[a as usize].store(b, Relaxed);
-                        neigh[b as usize].store(a, Relaxed);
                     }
-                }
-                _ => {
-                    bad.fetch_add(1, Relaxed);
-                    first.get_or_insert_with(|| TopoError::FaceInManyTets {
-                        face: unpack_triple(g[0]).map(PointId::from_raw),
-                        tets: g.iter().map(|&k| FaceRef::from_raw(low(k)).tet()).collect(),
-                        more: 0,
-                    });
-                }
-            });
-            first
-        })
-        .collect::<Vec<_>>()
-        .into_iter()
-        .flatten()
-        .next();
+                });
+                first
+            })
+            .collect::<Vec<_>>()
+            .into_iter()
+            .flatten()
+            .next();
+        if first_bad.is_none() {
+            first_bad = first;
+        }
+    });
     if let Some(mut e) = first_bad {
         let others = bad.into_inner() - 1;
         match &mut e {

@@ -125,6 +125,35 @@ struct FaceAcc {
     boundary: usize,
 }
 
+fn fa_merge(a: FaceAcc, b: FaceAcc) -> FaceAcc {
+    FaceAcc {
+        found: a.found.merge(b.found),
+        interior: a.interior + b.interior,
+        interface: a.interface + b.interface,
+        boundary: a.boundary + b.boundary,
+    }
+}
+
+/// The input triangles' side of the check, summed over the slices of the
+/// face table: problems, and the enclosed volume's flux (six times it)
+/// with its absolute sum (for the rounding bound).
+#[derive(Default)]
+struct InputSide {
+    found: Found,
+    flux: f64,
+    flux_abs: f64,
+}
+
+impl InputSide {
+    fn merge(self, o: InputSide) -> InputSide {
+        InputSide {
+            found: self.found.merge(o.found),
+            flux: self.flux + o.flux,
+            flux_abs: self.flux_abs + o.flux_abs,
+        }
+    }
+}
+
 impl TetMesh {
     /// Checks every invariant: point ids in range, no repeated vertex in a
     /// tet, every tet positive under the exact predicate, every face in at
@@ -160,12 +189,26 @@ impl TetMesh {
             Some(tris) => input_keys(tris, np),
         };
         found = found.merge(f);
-        let keys = face_keys(&self.tets);
-        let fa = self.check_faces(&keys, tris.map(|t| (t, &in_keys[..])), neigh_ok, region_ok);
+        // Slice by slice of the face table (by smallest vertex); the input
+        // triangles of a slice are a run of their sorted keys.
+        let mut fa = FaceAcc::default();
+        let mut side = InputSide::default();
+        for_each_key_slice(&self.tets, |keys, r| {
+            fa = fa_merge(
+                std::mem::take(&mut fa),
+                self.check_faces(keys, tris.map(|t| (t, &in_keys[..])), neigh_ok, region_ok),
+            );
+            if let Some(tris) = tris {
+                let lo = in_keys.partition_point(|&k| unpack_triple(k)[0] < r.start);
+                let hi = in_keys.partition_point(|&k| unpack_triple(k)[0] < r.end);
+                let part = self.check_input_side(tris, keys, &in_keys[lo..hi], region_ok);
+                side = std::mem::take(&mut side).merge(part);
+            }
+        });
         found = found.merge(fa.found);
         let mut surface_volume = None;
-        if let Some(tris) = tris {
-            let (f, vs) = self.check_input_side(tris, &keys, &in_keys, region_ok, ta.vol6);
+        if tris.is_some() {
+            let (f, vs) = self.volume_match(side, ta.vol6);
             found = found.merge(f);
             surface_volume = Some(vs);
         }
@@ -435,31 +478,24 @@ impl TetMesh {
                 });
                 acc
             })
-            .reduce(FaceAcc::default, |a, b| FaceAcc {
-                found: a.found.merge(b.found),
-                interior: a.interior + b.interior,
-                interface: a.interface + b.interface,
-                boundary: a.boundary + b.boundary,
-            })
+            .reduce(FaceAcc::default, fa_merge)
     }
 
-    /// The input side: triangles that are no boundary face, and the
-    /// enclosed volume (interface triangles enclose nothing) against the
-    /// tets' (`vol6`, six times theirs). The problems, and the surface's
-    /// volume.
+    /// The input side of one slice of the face table (`keys`, and the
+    /// input triangles' keys with smallest vertices in its range):
+    /// triangles that are no boundary face, and their share of the
+    /// enclosed volume (interface triangles enclose nothing).
     fn check_input_side(
         &self,
         tris: &[[u32; 3]],
         keys: &[u128],
         in_keys: &[u128],
         region_ok: bool,
-        vol6: f64,
-    ) -> (Found, f64) {
+    ) -> InputSide {
         let tets = &self.tets;
         let region = |t: TetId| self.region_or_0(t, region_ok);
-        let mut found = Found::default();
         let c = Aabb::from_points(&self.points).center();
-        let (f, flux, flux_abs) = group_chunks(in_keys)
+        let (found, flux, flux_abs) = group_chunks(in_keys)
             .par_iter()
             .map(|chunk| {
                 let mut f = Found::default();
@@ -509,7 +545,22 @@ impl TetMesh {
                 || (Found::default(), 0.0, 0.0),
                 |a, b| (a.0.merge(b.0), a.1 + b.1, a.2 + b.2),
             );
-        found = found.merge(f);
+        InputSide {
+            found,
+            flux,
+            flux_abs,
+        }
+    }
+
+    /// The enclosed volume (the input triangles' flux, `side`) against the
+    /// tets' (`vol6`, six times theirs): the problems, and the surface's
+    /// volume.
+    fn volume_match(&self, side: InputSide, vol6: f64) -> (Found, f64) {
+        let InputSide {
+            mut found,
+            flux,
+            flux_abs,
+        } = side;
         let (vm, vs) = (vol6 / 6.0, flux / 6.0);
         // Rounding bound of both sums, or the relative tolerance.
         let tol = (VOLUME_RTOL * vm.abs().max(vs.abs()))

@@ -5,6 +5,7 @@
 use crate::ids::*;
 use crate::tetmesh::TET_FACES;
 use rayon::prelude::*;
+use crate::slices::Slices;
 
 /// The three vertex ids sorted ascending, and whether sorting took an odd
 /// permutation. Two faces with the same triple are seen from opposite sides
@@ -63,29 +64,39 @@ pub(crate) fn has_repeat(t: &[PointId; 4]) -> bool {
     t[0] == t[1] || t[0] == t[2] || t[0] == t[3] || t[1] == t[2] || t[1] == t[3] || t[2] == t[3]
 }
 
-/// Sorted face keys of all tets without repeated vertices.
-pub(crate) fn face_keys(tets: &[[PointId; 4]]) -> Vec<u128> {
-    // Filled in place (indexed, no intermediate lists); a repeating tet's
-    // slots get the largest key, which no face can have (its low 32 bits
-    // would be NO_FACE), and are cut off after sorting.
-    let mut keys = vec![0u128; 4 * tets.len()];
-    keys.par_chunks_mut(4)
-        .zip(tets.par_iter())
-        .enumerate()
-        .for_each(|(t, (k, tet))| {
-            let skip = has_repeat(tet);
-            for f in 0..4 {
-                k[f] = if skip {
-                    u128::MAX
-                } else {
-                    pack(sort3(face_verts(tet, f)).0, (4 * t + f) as u32)
-                };
+/// The sorted face keys of all tets without repeated vertices, slice by
+/// slice of the smallest vertex id: `f` gets each slice's keys, sorted,
+/// with the range of smallest ids it covers (the first starts at 0, the
+/// last ends at `u32::MAX`). In order, the slices are the whole sorted
+/// table, and a group (one triple) never spans two.
+pub(crate) fn for_each_key_slice(
+    tets: &[[PointId; 4]],
+    mut f: impl FnMut(&[u128], std::ops::Range<u32>),
+) {
+    // A face's smallest vertex is the tet's smallest (three faces) unless
+    // the face is the one opposite it (its smallest is the tet's second).
+    let sl = Slices::new(tets, [3, 1, 0], false);
+    let mut keys: Vec<u128> = Vec::new();
+    for (k, r) in sl.ranges.iter().enumerate() {
+        let k = k as u8;
+        sl.gather(k, tets, &mut keys, u128::MAX, |t, tet, [a, b, _, c], out| {
+            if c == u8::MAX {
+                return 0; // repeats a vertex: no proper faces
             }
+            let m = (((a == k) as u8) * (0xf ^ (1 << c))) | (((b == k) as u8) << c);
+            let mut n = 0;
+            for f in 0..4 {
+                if m >> f & 1 == 1 {
+                    out[n] = pack(sort3(face_verts(tet, f)).0, (4 * t + f) as u32);
+                    n += 1;
+                }
+            }
+            n
         });
-    keys.par_sort_unstable();
-    let n = keys.partition_point(|&k| k != u128::MAX);
-    keys.truncate(n);
-    keys
+        keys.par_sort_unstable();
+        keys.truncate(keys.partition_point(|&x| x != u128::MAX));
+        f(&keys, r.clone());
+    }
 }
 
 /// Splits a sorted key array into about `8 * threads` chunks that start at
@@ -178,5 +189,45 @@ mod tests {
         assert_eq!(groups, 1000);
         assert_eq!(find_triple(&keys, [5, 6, 7]).len(), 3);
         assert_eq!(find_triple(&keys, [5, 6, 8]).len(), 0);
+    }
+
+    /// The slices, in order, are the whole sorted table.
+    #[test]
+    fn slices_make_the_whole_table() {
+        let mut x = 7u64;
+        let mut rng = move || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            (x >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for n in [1usize, 100, 40_000, 90_000] {
+            let np = (n / 3).max(4) as u32;
+            let tets: Vec<[PointId; 4]> = (0..n)
+                .map(|_| [0; 4].map(|_| PointId::from_raw((rng() * np as f64) as u32)))
+                .collect();
+            let mut whole: Vec<u128> = (0..n)
+                .filter(|&t| !has_repeat(&tets[t]))
+                .flat_map(|t| (0..4).map(move |f| (t, f)))
+                .map(|(t, f)| pack(sort3(face_verts(&tets[t], f)).0, (4 * t + f) as u32))
+                .collect();
+            whole.sort_unstable();
+            let mut got = Vec::new();
+            let mut slices = 0;
+            let mut next = 0;
+            for_each_key_slice(&tets, |keys, r| {
+                assert_eq!(r.start, next);
+                next = r.end;
+                assert!(keys.iter().all(|&k| r.contains(&unpack_triple(k)[0])));
+                got.extend_from_slice(keys);
+                slices += 1;
+            });
+            assert_eq!(next, u32::MAX);
+            assert_eq!(got, whole, "{n} tets");
+            assert!((1..=9).contains(&slices));
+            if 4 * n > 2 * (1 << 16) {
+                assert!(slices > 1, "{n} tets in one slice");
+            }
+        }
     }
 }

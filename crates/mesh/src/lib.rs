@@ -8,7 +8,8 @@
 //! Orientation: every tet `abcd` has `orient3d(a,b,c,d) > 0`, and face `f`
 //! listed by [`TET_FACES`] has its right-hand normal pointing out of the tet.
 //!
-//! - `build_adjacency`, `boundary_faces`: pairing faces by a sorted table.
+//! - `build_adjacency`, `boundary_faces`: pairing faces by a sorted table,
+//!   built in slices of vertex id.
 //! - `check`, `check_against_surface`: all invariants, exact orientation.
 //! - [`quality`]: dihedral angles, radius and mean ratio, edge length vs size.
 //! - [`generate`]: structured box meshes for tests.
@@ -23,6 +24,7 @@ pub mod generate;
 pub mod ids;
 mod problem;
 pub mod quality;
+mod slices;
 mod tetmesh;
 
 pub use adjacency::{face_neighbours, TopoError, MAX_TETS};

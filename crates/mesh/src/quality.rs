@@ -130,43 +130,56 @@ fn tet_coords(mesh: &TetMesh, t: &[PointId; 4]) -> Option<[P3; 4]> {
     Some(c)
 }
 
-/// Edge length over the target size at the edge midpoint, once per edge.
+/// Edge length over the target size at the edge midpoint, once per edge,
+/// in order of (smaller, larger) point id: `f` gets them in slices.
 /// Edges with an out-of-range point, or where `size` is not positive, are
-/// left out.
-pub fn edge_size_ratios(mesh: &TetMesh, size: impl Fn(P3) -> f64 + Sync) -> Vec<f64> {
+/// left out. Sliced by the smaller id, like the face table: the whole
+/// edge list (48 B per tet) set the quality report's peak.
+pub fn for_each_edge_size_ratio(
+    mesh: &TetMesh,
+    size: impl Fn(P3) -> f64 + Sync,
+    mut f: impl FnMut(&[f64]),
+) {
     let np = mesh.points.len();
-    // Six slots per tet; edges with a bad id get u64::MAX, cut after sorting.
-    let mut edges = vec![0u64; 6 * mesh.tets.len()];
-    edges
-        .par_chunks_mut(6)
-        .zip(mesh.tets.par_iter())
-        .for_each(|(k, t)| {
-            for (slot, e) in k.iter_mut().zip(TET_EDGES) {
-                let (a, b) = (
-                    t[e[0]].raw().min(t[e[1]].raw()),
-                    t[e[0]].raw().max(t[e[1]].raw()),
-                );
-                *slot = if a != b && (b as usize) < np {
-                    ((a as u64) << 32) | b as u64
-                } else {
-                    u64::MAX
-                };
+    // An edge's smaller id is a tet's smallest (three edges), second (two)
+    // or third (one); a repeating tet has fewer edges.
+    let sl = crate::slices::Slices::new(&mesh.tets, [3, 2, 1], true);
+    let mut edges: Vec<u64> = Vec::new();
+    let mut ratios: Vec<f64> = Vec::new();
+    for k in 0..sl.ranges.len() {
+        let k = k as u8;
+        sl.gather(k, &mesh.tets, &mut edges, u64::MAX, |_, t, g, out| {
+            // The edges from the tet's i-th smallest id to larger ones,
+            // for each rank i whose id is in the slice.
+            let (v, _) = crate::slices::ranked(t);
+            let mut n = 0;
+            for i in 0..3 {
+                if g[i] != k {
+                    continue;
+                }
+                for j in i + 1..4 {
+                    if v[i] != v[j] && (v[j] as usize) < np {
+                        out[n] = ((v[i] as u64) << 32) | v[j] as u64;
+                        n += 1;
+                    }
+                }
             }
+            n
         });
-    edges.par_sort_unstable();
-    edges.truncate(edges.partition_point(|&e| e != u64::MAX));
-    edges.dedup();
-    edges
-        .par_iter()
-        .filter_map(|&e| {
+        edges.par_sort_unstable();
+        edges.truncate(edges.partition_point(|&e| e != u64::MAX));
+        edges.dedup();
+        ratios.clear();
+        ratios.par_extend(edges.par_iter().filter_map(|&e| {
             let (a, b) = (
                 mesh.points[(e >> 32) as usize],
                 mesh.points[e as u32 as usize],
             );
             let h = size(scale(parafront_geom::add(a, b), 0.5));
             (h > 0.0).then(|| dist(a, b) / h)
-        })
-        .collect()
+        }));
+        f(&ratios);
+    }
 }
 
 /// Min, mean and max of a measure.
@@ -480,13 +493,14 @@ impl QualityReport {
         let (edge_ratio, edge_ratio_hist) = match size {
             None => (None, None),
             Some(h) => {
-                let r = edge_size_ratios(mesh, h);
                 let mut s = StatAcc::EMPTY;
                 let mut hist = Histogram::new(0.0, 3.0, 30);
-                for &x in &r {
-                    s.add(x);
-                    hist.add(x);
-                }
+                for_each_edge_size_ratio(mesh, h, |r| {
+                    for &x in r {
+                        s.add(x);
+                        hist.add(x);
+                    }
+                });
                 (Some(s.stat()), Some(hist))
             }
         };

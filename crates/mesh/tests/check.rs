@@ -493,3 +493,73 @@ fn large_box_timing() {
         quality::QualityReport::new(&m);
     });
 }
+
+/// A box large enough that the face table is built in several slices:
+/// the adjacency matches a plain pairing, and corruptions anywhere in the
+/// id range are all found.
+#[test]
+fn large_box_across_slices_of_the_face_table() {
+    use std::collections::HashMap;
+    let n = 24;
+    let mut m = unit_box(n);
+    assert!(4 * m.tets.len() > 4 * (1 << 16));
+    let s = m.check_against_surface(&tris_of(&m)).unwrap();
+    assert_eq!(s.n_boundary_faces, 2 * 6 * n * n);
+    assert!((s.surface_volume.unwrap() - 1.0).abs() < 1e-12);
+
+    // build_adjacency against a hash-map pairing of the sorted triples.
+    let mut by: HashMap<[u32; 3], Vec<u32>> = HashMap::new();
+    for i in 0..4 * m.tets.len() as u32 {
+        let mut v = m.face_points(FaceRef::from_raw(i)).map(|p| p.raw());
+        v.sort();
+        by.entry(v).or_default().push(i);
+    }
+    m.build_adjacency().unwrap();
+    for fs in by.values() {
+        match fs[..] {
+            [a] => assert!(m.neigh[a as usize].is_none()),
+            [a, b] => {
+                assert_eq!(m.neigh[a as usize], FaceRef::from_raw(b));
+                assert_eq!(m.neigh[b as usize], FaceRef::from_raw(a));
+            }
+            _ => panic!("{fs:?}"),
+        }
+    }
+    assert_eq!(m.boundary_faces().len(), 2 * 6 * n * n);
+
+    // Input triangles dropped and flipped at both ends and the middle.
+    let tris = tris_of(&m);
+    let last = tris.len() - 1;
+    let mut t = tris.clone();
+    for i in [last, tris.len() / 2, 0] {
+        t.remove(i);
+    }
+    let mid = t.len() / 2;
+    t[mid].swap(0, 1);
+    t[last - 4].swap(1, 2);
+    let e = m.check_against_surface(&t).unwrap_err();
+    assert_eq!(e.count(ProblemKind::ExtraBoundaryFace), 3, "{e}");
+    assert_eq!(e.count(ProblemKind::FlippedBoundaryFace), 2, "{e}");
+    assert_eq!(e.count(ProblemKind::VolumeMismatch), 1, "{e}");
+
+    // Tets at both ends of the id range duplicated: each face of each in
+    // three tets, or twice from one side.
+    let mut d = m.clone();
+    d.neigh.clear();
+    for t in [0, d.tets.len() - 1] {
+        d.tets.push(d.tets[t]);
+        d.region.push(0);
+    }
+    let e = d.check().unwrap_err();
+    assert_eq!(
+        e.count(ProblemKind::FaceInManyTets) + e.count(ProblemKind::FaceSameSide),
+        8,
+        "{e}"
+    );
+    match d.build_adjacency() {
+        Err(TopoError::FaceInManyTets { more, .. } | TopoError::FaceSameSide { more, .. }) => {
+            assert_eq!(more, 7)
+        }
+        r => panic!("{r:?}"),
+    }
+}

@@ -205,3 +205,21 @@ fn merged_reports_of_two_halves_are_the_whole() {
     // Edges on the cut count in both halves.
     assert!(g.edge_ratio.unwrap().count >= whole.edge_ratio.unwrap().count);
 }
+
+/// A box large enough that the edges are taken in several slices: each
+/// edge still counted once, and the histogram holds them all.
+#[test]
+fn edge_ratios_of_a_large_box_count_each_edge_once() {
+    let (nx, ny, nz) = (20, 24, 30);
+    let m = box_mesh(nx, ny, nz, [0.0; 3], [nx as f64, ny as f64, nz as f64]);
+    assert!(6 * m.tets.len() > 4 * (1 << 16));
+    let r = QualityReport::with_size(&m, |_| 1.0);
+    let e = r.edge_ratio.unwrap();
+    let axis = nx * (ny + 1) * (nz + 1) + (nx + 1) * ny * (nz + 1) + (nx + 1) * (ny + 1) * nz;
+    let diag = nx * ny * (nz + 1) + nx * (ny + 1) * nz + (nx + 1) * ny * nz;
+    assert_eq!(e.count, axis + diag + nx * ny * nz);
+    assert_eq!(r.edge_ratio_hist.unwrap().total() as usize, e.count);
+    let mean = (axis as f64 + diag as f64 * 2f64.sqrt() + (nx * ny * nz) as f64 * 3f64.sqrt())
+        / e.count as f64;
+    assert!((e.mean - mean).abs() < 1e-9, "{} {mean}", e.mean);
+}

@@ -23,9 +23,8 @@ impl<'a> Front<'a> {
 
     pub(super) fn remove_face(&mut self, id: u32) {
         let i = id as usize;
-        debug_assert!(self.fv[i].alive);
-        self.fv[i].alive = false;
         let v = self.fv[i].v;
+        self.fv.kill(i);
         if let Some(m) = &mut self.fmap {
             m.remove(&sorted3(v));
         }

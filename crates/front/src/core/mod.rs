@@ -20,6 +20,7 @@ mod fill;
 mod free;
 mod policy;
 mod recover;
+mod store;
 
 use policy::Clearance;
 
@@ -332,7 +333,7 @@ struct Front<'a> {
     hp: Vec<f64>,
     n_input: usize,
     /// Every face ever made, by id (dead ones too: ids stay put).
-    fv: Vec<Face>,
+    fv: store::Faces,
     /// Live faces by their sorted corners, built when recovery first needs
     /// it: AF5 finds a new tet's matching faces among AF2's near faces, so
     /// the front itself keeps no map (a hash update or two per face made).
@@ -477,7 +478,7 @@ impl<'a> Front<'a> {
             pts: input.points,
             hp: input.point_size,
             n_input: n,
-            fv: Vec::new(),
+            fv: store::Faces::default(),
             fmap: None,
             n_front: 0,
             heap: MinQueue::default(),
