@@ -167,6 +167,10 @@ struct MeshArgs {
     /// with improvement on, before and after.
     #[arg(long)]
     plot: Option<PathBuf>,
+    /// Also report every edge's length over the target size at its
+    /// midpoint (min, mean, max): how well the mesh meets the size field.
+    #[arg(long)]
+    size_report: bool,
     /// If the front cannot be closed, write what it made (tets) and the
     /// faces it left (triangles) to this file (.vtu, .msh or .mesh).
     #[arg(long)]
@@ -454,6 +458,7 @@ fn mesh_options(a: &MeshArgs) -> Result<MeshOptions, Fail> {
         o.optimize_parts = n;
     }
     o.fill_after = a.fill_after;
+    o.size_report = a.size_report;
     o.lattice = a.lattice;
     o.thin_depth = a.thin_depth;
     o.serial_from = a.serial_from;
@@ -828,6 +833,12 @@ fn print_summary(sum: &Summary) {
             100.0 * q.share_min_dihedral_below,
             q.radius_ratio.mean
         );
+        if let Some(e) = &q.edge_ratio {
+            println!(
+                "edge length / target size: min {:.3}, mean {:.3}, max {:.3} ({} edges)",
+                e.min, e.mean, e.max, e.count
+            );
+        }
     }
 }
 

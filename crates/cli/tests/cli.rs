@@ -468,3 +468,38 @@ fn an_extreme_needle_is_closed_by_the_fill() {
     m.check_against_surface(&s.tris).unwrap();
     assert!((m.volume() - s.signed_volume()).abs() < 1e-9 * s.signed_volume());
 }
+
+/// `--size-report` adds a line on the edges against the size field; the
+/// default summary has none (it cost more than half the report's time).
+#[test]
+fn size_report_on_demand() {
+    let run = |extra: &[&str], name: &str| {
+        let o = bin()
+            .args(["demo", "-o"])
+            .arg(tmp(name))
+            .args(extra)
+            .output()
+            .unwrap();
+        let text = String::from_utf8_lossy(&o.stdout).to_string();
+        assert!(o.status.success(), "{text}");
+        text
+    };
+    let plain = run(&[], "sr0.vtu");
+    assert!(plain.contains("quality: min dihedral"), "{plain}");
+    assert!(!plain.contains("edge length / target size"), "{plain}");
+    let text = run(&["--size-report"], "sr1.vtu");
+    let line = text
+        .lines()
+        .find(|l| l.starts_with("edge length / target size:"))
+        .unwrap_or_else(|| panic!("no size report: {text}"));
+    let nums: Vec<f64> = line
+        .split(|c: char| !(c.is_ascii_digit() || c == '.'))
+        .filter_map(|w| w.parse().ok())
+        .collect();
+    let [min, mean, max, edges] = nums[..] else {
+        panic!("{line}")
+    };
+    assert!(0.0 < min && min <= mean && mean <= max, "{line}");
+    assert!(mean > 0.5 && mean < 2.0, "{line}");
+    assert!(edges > tets_said(&text) as f64, "{line}");
+}

@@ -223,7 +223,9 @@ pub(crate) fn finish_pieces<C: Comm>(
     sum.tets = tets;
     if !opts.no_quality {
         let t0 = Instant::now();
-        sum.quality = crate::pieces::pieces_quality(comm, &sum.pieces, &|p| sizing.size(p));
+        let size = |p| sizing.size(p);
+        let size: Option<&(dyn Fn(_) -> f64 + Sync)> = opts.size_report.then_some(&size);
+        sum.quality = crate::pieces::pieces_quality(comm, &sum.pieces, size);
         sum.push(Stage::Quality, t0.elapsed().as_secs_f64());
     }
     sum.regions = fronts.len();

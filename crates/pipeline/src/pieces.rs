@@ -266,7 +266,7 @@ fn add_stats(a: &mut ImproveStats, b: &ImproveStats) {
 pub(crate) fn pieces_quality<C: Comm>(
     comm: &C,
     pieces: &[Piece],
-    size: &(dyn Fn(parafront_geom::P3) -> f64 + Sync),
+    size: Option<&(dyn Fn(parafront_geom::P3) -> f64 + Sync)>,
 ) -> Option<QualityReport> {
     let held = comm.owned().len().max(1);
     let local: Vec<Option<QWire>> = (0..comm.owned().len())
@@ -281,7 +281,10 @@ pub(crate) fn pieces_quality<C: Comm>(
                         tets: pc.tets.iter().map(|t| t.map(PointId::from_raw)).collect(),
                         ..Default::default()
                     };
-                    QualityReport::with_size(&m, size)
+                    match size {
+                        Some(h) => QualityReport::with_size(&m, h),
+                        None => QualityReport::new(&m),
+                    }
                 })
                 .reduce(|a, b| a.merge(&b))
                 .map(QWire)

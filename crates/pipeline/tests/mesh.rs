@@ -20,6 +20,10 @@ fn mesh_regions(s: &Surface) -> parafront_mesh::TetMesh {
 }
 
 fn mesh_with(s: &Surface, o: &MeshOptions) -> parafront_mesh::TetMesh {
+    let o = &MeshOptions {
+        size_report: true,
+        ..o.clone()
+    };
     let (m, summary) = mesh_surface(s, o).unwrap_or_else(|e| panic!("meshing failed: {e}"));
     assert_eq!(summary.tets, m.tets.len());
     m.check_against_surface(&s.tris)
@@ -40,7 +44,7 @@ fn mesh_with(s: &Surface, o: &MeshOptions) -> parafront_mesh::TetMesh {
     assert_eq!(sq.n_inverted, 0);
     let er = sq
         .edge_ratio
-        .expect("the run's size field gives edge ratios");
+        .expect("size_report: the run's size field gives edge ratios");
     assert!(er.mean > 0.5 && er.mean < 2.0, "mean edge/size {}", er.mean);
     assert!(
         q.mean_ratio.min >= 1.9e-3,
@@ -184,4 +188,19 @@ fn no_quality_skips_the_report_only() {
     assert!(s1.quality.is_none());
     assert!(s1.stages.iter().all(|st| st.0 != Stage::Quality));
     assert_eq!(m0.tets, m1.tets);
+    // Edge lengths against the size field only when asked, and the rest
+    // of the report the same.
+    let q0 = s0.quality.unwrap();
+    assert!(q0.edge_ratio.is_none() && q0.edge_ratio_hist.is_none());
+    let o = MeshOptions {
+        size_report: true,
+        ..MeshOptions::default()
+    };
+    let (m2, s2) = mesh_surface(&s, &o).unwrap();
+    assert_eq!(m0.tets, m2.tets);
+    let q2 = s2.quality.unwrap();
+    let e = q2.edge_ratio.unwrap();
+    assert!(e.count > m2.tets.len() && e.mean > 0.5 && e.mean < 2.0, "{e:?}");
+    assert_eq!(q2.edge_ratio_hist.unwrap().total() as usize, e.count);
+    assert_eq!(q0.radius_ratio, q2.radius_ratio);
 }
