@@ -62,6 +62,9 @@ impl<'a> Front<'a> {
                 seed += 1;
                 continue;
             }
+            // The seed may die in the fill; its pocket is then still
+            // found from its corners (a dead face's may be gone).
+            let v0 = self.fv[seed].v;
             let r = self.fill_pocket(seed as u32);
             if !matches!(r, Pocket::Failed) {
                 progress += 1;
@@ -70,7 +73,7 @@ impl<'a> Front<'a> {
                 failed += 1;
                 skip.resize(self.fv.len(), false);
                 // Do not try the faces of this pocket again in this round.
-                for f in self.pocket(seed as u32) {
+                for f in self.pocket_of(seed as u32, v0) {
                     skip[f as usize] = true;
                 }
             }
@@ -79,8 +82,14 @@ impl<'a> Front<'a> {
         (progress, failed)
     }
 
-    /// The faces reachable from `seed` over shared edges.
+    /// The faces reachable from live face `seed` over shared edges.
     fn pocket(&self, seed: u32) -> Vec<u32> {
+        self.pocket_of(seed, self.fv[seed as usize].v)
+    }
+
+    /// The faces reachable over shared edges from face `seed` with corners
+    /// `v0`, which may have died since (the others are live).
+    fn pocket_of(&self, seed: u32, v0: [u32; 3]) -> Vec<u32> {
         let mut out = vec![seed];
         let mut seen = FxHashMap::default();
         seen.insert(seed, ());
@@ -88,7 +97,7 @@ impl<'a> Front<'a> {
         while i < out.len() && out.len() <= MAX_POCKET {
             let f = out[i];
             i += 1;
-            let v = self.fv[f as usize].v;
+            let v = if f == seed { v0 } else { self.fv[f as usize].v };
             let bb = tri_box(&self.pts, v);
             self.fgrid.query(&bb, |g, _| {
                 if seen.contains_key(&g) || !self.fv[g as usize].alive {

@@ -4,7 +4,9 @@
 //! A face lives from the tet that opens it to the tet that closes it, so
 //! most chunks empty soon after they fill: on sphere_1e6 the store held
 //! 20 MB of faces at the end of the front (1M made), 4 MB of them in
-//! chunks with a live face. A freed chunk reads as dead faces.
+//! chunks with a live face. A freed chunk reads as dead faces: code
+//! that needs a face's corners after it may have died keeps them itself
+//! (`fill_pockets`).
 use super::Face;
 use std::ops::{Index, IndexMut};
 
@@ -12,9 +14,12 @@ use std::ops::{Index, IndexMut};
 const BITS: u32 = 10;
 const MASK: usize = (1 << BITS) - 1;
 
+/// What a face of a freed chunk reads as: dead, with corners and owner
+/// out of any range, so that code using a dead face's corners (which
+/// freed chunks no longer hold) fails loudly instead of using point 0.
 const DEAD: Face = Face {
-    v: [0; 3],
-    owner: u32::MAX,
+    v: [u32::MAX; 3],
+    owner: u32::MAX - 1,
     tries: 0,
     alive: false,
 };
