@@ -137,20 +137,27 @@ impl Bins {
 }
 
 /// Which DDG tets hold a point (closed tets, exact predicates).
+///
+/// The tets by point id (16 B each) rather than by their corners (96 B):
+/// every process holds a locator, and on sphere_5e6's DDG the corners
+/// were 17 MB of it.
 #[derive(Clone, Debug)]
 pub struct Locator {
     bins: Bins,
-    tets: Vec<[P3; 4]>,
+    points: Vec<P3>,
+    tets: Vec<[u32; 4]>,
 }
 
 impl Locator {
     /// Bins the tets of `d`.
     pub fn new(d: &Ddg) -> Locator {
-        let tets: Vec<[P3; 4]> = (0..d.tets.len()).map(|t| d.tet_points(t)).collect();
-        let boxes = tets.iter().map(|p| Aabb::from_points(p.iter())).collect();
+        let boxes = (0..d.tets.len())
+            .map(|t| Aabb::from_points(d.tet_points(t).iter()))
+            .collect();
         Locator {
             bins: Bins::new(boxes, 0.5),
-            tets,
+            points: d.points.clone(),
+            tets: d.tets.clone(),
         }
     }
 
@@ -175,7 +182,7 @@ impl Locator {
     /// place of a corner may be negative.
     #[inline]
     fn holds(&self, t: u32, p: P3) -> Option<bool> {
-        let q = self.tets[t as usize];
+        let q = self.tets[t as usize].map(|v| self.points[v as usize]);
         if q.contains(&p) {
             return Some(false);
         }
