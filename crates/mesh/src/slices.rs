@@ -116,17 +116,21 @@ fn id_ranges(tets: &[[PointId; 4]], total: usize, per_rank: [u32; 3]) -> Vec<Ran
     if total <= MIN_SLICE {
         return std::iter::once(0..u32::MAX).collect();
     }
+    // A valid mesh has fewer points than 4 ids per tet; ids past that (a
+    // corrupt mesh under check) are counted with the last, so that the
+    // histogram never grows with a bad id.
     let top = tets
         .par_iter()
         .map(|t| t.iter().map(|p| p.raw()).max().unwrap_or(0))
         .max()
-        .unwrap_or(0) as usize;
+        .unwrap_or(0)
+        .min((4 * tets.len()).min(u32::MAX as usize) as u32) as usize;
     let counts: Vec<AtomicU32> = (0..=top).into_par_iter().map(|_| AtomicU32::new(0)).collect();
     tets.par_iter().for_each(|t| {
         let (v, _) = ranked(t);
         for r in 0..3 {
             if per_rank[r] > 0 {
-                counts[v[r] as usize].fetch_add(per_rank[r], Relaxed);
+                counts[(v[r] as usize).min(top)].fetch_add(per_rank[r], Relaxed);
             }
         }
     });

@@ -562,4 +562,15 @@ fn large_box_across_slices_of_the_face_table() {
         }
         r => panic!("{r:?}"),
     }
+
+    // A point id near u32::MAX: reported, and the slices' histogram does
+    // not grow with it (it is counted with the largest ids).
+    let mut b = m.clone();
+    b.neigh.clear();
+    b.tets[1000][2] = PointId::from_raw(u32::MAX - 5);
+    let e = b.check().unwrap_err();
+    assert_eq!(e.count(ProblemKind::PointOutOfRange), 1, "{e}");
+    assert!(b.clone().build_adjacency().is_ok());
+    let q = QualityReport::with_size(&b, |_| 1.0);
+    assert_eq!(q.n_skipped, 1);
 }
