@@ -3,9 +3,9 @@
 //! with the same three vertices lie next to each other. Adjacency building
 //! and `check()` both pair faces through it; it needs no coordinates.
 use crate::ids::*;
+use crate::slices::Slices;
 use crate::tetmesh::TET_FACES;
 use rayon::prelude::*;
-use crate::slices::Slices;
 
 /// The three vertex ids sorted ascending, and whether sorting took an odd
 /// permutation. Two faces with the same triple are seen from opposite sides
@@ -79,20 +79,26 @@ pub(crate) fn for_each_key_slice(
     let mut keys: Vec<u128> = Vec::new();
     for (k, r) in sl.ranges.iter().enumerate() {
         let k = k as u8;
-        sl.gather(k, tets, &mut keys, u128::MAX, |t, tet, [a, b, _, c], out| {
-            if c == u8::MAX {
-                return 0; // repeats a vertex: no proper faces
-            }
-            let m = (((a == k) as u8) * (0xf ^ (1 << c))) | (((b == k) as u8) << c);
-            let mut n = 0;
-            for f in 0..4 {
-                if m >> f & 1 == 1 {
-                    out[n] = pack(sort3(face_verts(tet, f)).0, (4 * t + f) as u32);
-                    n += 1;
+        sl.gather(
+            k,
+            tets,
+            &mut keys,
+            u128::MAX,
+            |t, tet, [a, b, _, c], out| {
+                if c == u8::MAX {
+                    return 0; // repeats a vertex: no proper faces
                 }
-            }
-            n
-        });
+                let m = (((a == k) as u8) * (0xf ^ (1 << c))) | (((b == k) as u8) << c);
+                let mut n = 0;
+                for f in 0..4 {
+                    if m >> f & 1 == 1 {
+                        out[n] = pack(sort3(face_verts(tet, f)).0, (4 * t + f) as u32);
+                        n += 1;
+                    }
+                }
+                n
+            },
+        );
         keys.par_sort_unstable();
         keys.truncate(keys.partition_point(|&x| x != u128::MAX));
         f(&keys, r.clone());

@@ -59,7 +59,12 @@ impl Slices {
                 for (g, t) in tg.iter_mut().zip(ts) {
                     let (v, c) = ranked(t);
                     let rep = crate::faces::has_repeat(t);
-                    *g = [slice_of(v[0]), slice_of(v[1]), slice_of(v[2]), if rep { u8::MAX } else { c }];
+                    *g = [
+                        slice_of(v[0]),
+                        slice_of(v[1]),
+                        slice_of(v[2]),
+                        if rep { u8::MAX } else { c },
+                    ];
                     if !rep || repeats {
                         for r in 0..3 {
                             cnt[g[r] as usize] += per_rank[r];
@@ -67,7 +72,11 @@ impl Slices {
                     }
                 }
             });
-        Slices { ranges, tag, counts }
+        Slices {
+            ranges,
+            tag,
+            counts,
+        }
     }
 
     /// Fills `out` with slice `k`'s items, tet by tet: `emit(t, tet, tag,
@@ -84,7 +93,11 @@ impl Slices {
         emit: impl Fn(usize, &[PointId; 4], [u8; 4], &mut [T]) -> usize + Sync,
     ) {
         let ns = self.ranges.len();
-        let sizes: Vec<usize> = self.counts.chunks(ns).map(|c| c[k as usize] as usize).collect();
+        let sizes: Vec<usize> = self
+            .counts
+            .chunks(ns)
+            .map(|c| c[k as usize] as usize)
+            .collect();
         out.clear();
         out.resize(sizes.iter().sum(), fill);
         let mut rest: &mut [T] = out;
@@ -125,7 +138,10 @@ fn id_ranges(tets: &[[PointId; 4]], total: usize, per_rank: [u32; 3]) -> Vec<Ran
         .max()
         .unwrap_or(0)
         .min((4 * tets.len()).min(u32::MAX as usize) as u32) as usize;
-    let counts: Vec<AtomicU32> = (0..=top).into_par_iter().map(|_| AtomicU32::new(0)).collect();
+    let counts: Vec<AtomicU32> = (0..=top)
+        .into_par_iter()
+        .map(|_| AtomicU32::new(0))
+        .collect();
     tets.par_iter().for_each(|t| {
         let (v, _) = ranked(t);
         for r in 0..3 {

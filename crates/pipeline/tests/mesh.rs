@@ -200,7 +200,10 @@ fn no_quality_skips_the_report_only() {
     assert_eq!(m0.tets, m2.tets);
     let q2 = s2.quality.unwrap();
     let e = q2.edge_ratio.unwrap();
-    assert!(e.count > m2.tets.len() && e.mean > 0.5 && e.mean < 2.0, "{e:?}");
+    assert!(
+        e.count > m2.tets.len() && e.mean > 0.5 && e.mean < 2.0,
+        "{e:?}"
+    );
     assert_eq!(q2.edge_ratio_hist.unwrap().total() as usize, e.count);
     assert_eq!(q0.radius_ratio, q2.radius_ratio);
 }

@@ -42,7 +42,8 @@ impl Faces {
         debug_assert!(f.alive);
         let (c, i) = (self.len >> BITS, self.len & MASK);
         if i == 0 {
-            self.chunks.push(Some(vec![DEAD; MASK + 1].into_boxed_slice()));
+            self.chunks
+                .push(Some(vec![DEAD; MASK + 1].into_boxed_slice()));
             self.live.push(0);
         }
         self.chunks[c].as_mut().expect("the last chunk is kept")[i] = f;
@@ -146,7 +147,11 @@ mod tests {
             }
         }
         for (c, (ch, &n)) in s.chunks.iter().zip(&s.live).enumerate() {
-            let want = plain[c << BITS..].iter().take(MASK + 1).filter(|f| f.alive).count();
+            let want = plain[c << BITS..]
+                .iter()
+                .take(MASK + 1)
+                .filter(|f| f.alive)
+                .count();
             assert_eq!(n as usize, want);
             assert_eq!(ch.is_none(), n == 0 && c + 1 < s.chunks.len(), "chunk {c}");
         }
