@@ -10,7 +10,7 @@ use crate::faces::*;
 use crate::ids::*;
 use crate::problem::*;
 use crate::tetmesh::TetMesh;
-use parafront_geom::{cross, dot, orient3d, sub, tet_volume6, Aabb};
+use parafront_geom::{cross, dot, orient3d, sub, tet_volume6, Aabb, P3};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, Ordering::Relaxed};
 
@@ -193,6 +193,8 @@ impl TetMesh {
         // triangles of a slice are a run of their sorted keys.
         let mut fa = FaceAcc::default();
         let mut side = InputSide::default();
+        // The flux's origin, the same for every slice.
+        let c = Aabb::from_points(&self.points).center();
         for_each_key_slice(&self.tets, |keys, r| {
             fa = fa_merge(
                 std::mem::take(&mut fa),
@@ -201,7 +203,7 @@ impl TetMesh {
             if let Some(tris) = tris {
                 let lo = in_keys.partition_point(|&k| unpack_triple(k)[0] < r.start);
                 let hi = in_keys.partition_point(|&k| unpack_triple(k)[0] < r.end);
-                let part = self.check_input_side(tris, keys, &in_keys[lo..hi], region_ok);
+                let part = self.check_input_side(tris, keys, &in_keys[lo..hi], region_ok, c);
                 side = std::mem::take(&mut side).merge(part);
             }
         });
@@ -484,17 +486,18 @@ impl TetMesh {
     /// The input side of one slice of the face table (`keys`, and the
     /// input triangles' keys with smallest vertices in its range):
     /// triangles that are no boundary face, and their share of the
-    /// enclosed volume (interface triangles enclose nothing).
+    /// enclosed volume (interface triangles enclose nothing), as the flux
+    /// about `c`.
     fn check_input_side(
         &self,
         tris: &[[u32; 3]],
         keys: &[u128],
         in_keys: &[u128],
         region_ok: bool,
+        c: P3,
     ) -> InputSide {
         let tets = &self.tets;
         let region = |t: TetId| self.region_or_0(t, region_ok);
-        let c = Aabb::from_points(&self.points).center();
         let (found, flux, flux_abs) = group_chunks(in_keys)
             .par_iter()
             .map(|chunk| {
