@@ -395,6 +395,8 @@ impl Work<'_> {
         self.dead_pt.push(false);
         self.p2t.push(u32::MAX);
         self.settled.push(false);
+        self.touched.push(self.clock);
+        self.move_idle.push(0);
         PointId::new(self.m.points.len() - 1)
     }
 }

@@ -391,6 +391,7 @@ impl Work<'_> {
             self.dok[t as usize] = false;
             for x in v {
                 self.settled[x.idx()] = false;
+                self.touched[x.idx()] = self.clock;
             }
         }
     }

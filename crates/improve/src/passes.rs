@@ -130,13 +130,15 @@ impl Improver<'_> {
             let bad = self.under_deg(insert::SMALL_DIHEDRAL);
             let mut changed = 0;
             for (d0, t) in bad {
-                if !self.unchanged(t, d0) {
+                if !self.unchanged(t, d0) || self.w.swap_idle(t) {
                     continue;
                 }
                 st.swap.tried += 1;
                 if self.swap_for_dihedral(t) == Outcome::Done {
                     st.swap.done += 1;
                     changed += 1;
+                } else {
+                    self.w.swap_idle[t as usize] = self.w.tick();
                 }
             }
             if changed == 0 {
@@ -187,9 +189,14 @@ impl Improver<'_> {
                     continue;
                 }
                 seen[p.idx()] = true;
+                if self.w.move_idle(p) {
+                    continue;
+                }
                 st.selective.tried += 1;
                 if self.w.count_move(p, &mut self.s) == Outcome::Done {
                     st.selective.done += 1;
+                } else {
+                    self.w.move_idle[p.idx()] = self.w.tick();
                 }
             }
         }

@@ -54,6 +54,16 @@ pub(crate) struct Work<'m> {
     /// Known to have no dihedral angle under 10° since it last changed
     /// (a cache for the passes on those tets).
     pub dok: Vec<bool>,
+    /// The passes on the tets under 10° try the same operations again and
+    /// again: a try that did nothing is not repeated until something near
+    /// it changes. `touched[p]`: the clock when a tet on point `p` last
+    /// changed, or `p` or a neighbour of it moved; `swap_idle[t]` and
+    /// `move_idle[p]`: the clock when a count swap of tet `t` or a count
+    /// move of point `p` last did nothing (0: never).
+    pub touched: Vec<u32>,
+    pub swap_idle: Vec<u32>,
+    pub move_idle: Vec<u32>,
+    pub clock: u32,
     free: Vec<u32>,
     stamp: Vec<u32>,
     gen: u32,
@@ -83,6 +93,30 @@ pub(crate) fn even(p: [usize; 4]) -> bool {
 }
 
 impl<'m> Work<'m> {
+    /// A count swap of tet `t` did nothing when last tried, and no tet on
+    /// its corners has changed nor a point near them moved since.
+    pub(crate) fn swap_idle(&self, t: u32) -> bool {
+        let at = self.swap_idle[t as usize];
+        at != 0
+            && self.m.tets[t as usize]
+                .iter()
+                .all(|p| self.touched[p.idx()] < at)
+    }
+
+    /// A count move of point `p` did nothing when last tried, and its ball
+    /// has not changed since.
+    pub(crate) fn move_idle(&self, p: PointId) -> bool {
+        let at = self.move_idle[p.idx()];
+        at != 0 && self.touched[p.idx()] < at
+    }
+
+    /// The clock for a try that did nothing: later than every change so
+    /// far, and no later than the changes to come.
+    pub(crate) fn tick(&mut self) -> u32 {
+        self.clock += 1;
+        self.clock
+    }
+
     /// Needs `m.neigh` built. `frozen` is per point (shorter means the rest
     /// is free).
     pub fn new(m: &'m mut TetMesh, frozen: &[bool]) -> Work<'m> {
@@ -115,6 +149,10 @@ impl<'m> Work<'m> {
             tested: vec![false; nt],
             settled: vec![false; np],
             dok: vec![false; nt],
+            touched: vec![0; np],
+            swap_idle: vec![0; nt],
+            move_idle: vec![0; np],
+            clock: 1,
             q,
             free: Vec::new(),
             stamp: vec![0; nt],
@@ -412,6 +450,7 @@ impl<'m> Work<'m> {
                 self.q.push(f64::INFINITY);
                 self.tested.push(false);
                 self.dok.push(false);
+                self.swap_idle.push(0);
                 (self.m.tets.len() - 1) as u32
             };
             slots.push(s);
@@ -435,6 +474,7 @@ impl<'m> Work<'m> {
             self.q[s] = quality(self.pts(new[i]));
             self.tested[s] = false;
             self.dok[s] = false;
+            self.swap_idle[s] = 0;
             for g in 0..4 {
                 let me = FaceRef::of(parafront_mesh::TetId::from_raw(s as u32), g);
                 let l = link[4 * i + g];
@@ -455,6 +495,7 @@ impl<'m> Work<'m> {
             for p in new[i] {
                 self.p2t[p.idx()] = s as u32;
                 self.settled[p.idx()] = false;
+                self.touched[p.idx()] = self.clock;
             }
         }
     }
@@ -502,5 +543,70 @@ pub(crate) fn compact_arrays(m: &mut TetMesh, dead_pt: &[bool]) {
     compact(&mut m.points, &pmap, 1);
     for t in &mut m.bnd_tris {
         *t = t.map(|p| PointId::from_raw(pmap[p.idx()]));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Point 0 inside an octahedron (points 1-6): eight tets around it.
+    fn ball_mesh() -> TetMesh {
+        let points = vec![
+            [0.1, 0.05, -0.02],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [-1.0, 0.0, 0.0],
+            [0.0, -1.0, 0.0],
+            [0.0, 0.0, 1.0],
+            [0.0, 0.0, -1.0],
+        ];
+        let mut m = TetMesh {
+            points,
+            ..Default::default()
+        };
+        let eq = [1, 2, 3, 4];
+        for i in 0..4 {
+            let (x, y) = (eq[i], eq[(i + 1) % 4]);
+            for apex in [5u32, 6] {
+                let mut v = [0, x, y, apex].map(PointId::from_raw);
+                let p = v.map(|q| m.points[q.idx()]);
+                if parafront_geom::orient3d(p[0], p[1], p[2], p[3]) < 0.0 {
+                    v.swap(2, 3);
+                }
+                m.push_tet(v, 0);
+            }
+        }
+        m.build_adjacency().unwrap();
+        m
+    }
+
+    /// A try marked idle stays idle until a point of its tet (or the
+    /// point itself) is touched: by a move in its ball, or by a new tet.
+    #[test]
+    fn idle_marks_end_when_something_near_changes() {
+        let mut m = ball_mesh();
+        let mut w = Work::new(&mut m, &[]);
+        let t = 0u32;
+        let p = PointId::from_raw(0);
+        assert!(!w.swap_idle(t) && !w.move_idle(p));
+        w.swap_idle[t as usize] = w.tick();
+        w.move_idle[p.idx()] = w.tick();
+        assert!(w.swap_idle(t) && w.move_idle(p));
+        // Moving a point of the octahedron touches every point of its
+        // ball, point 0 and the corners of tet 0 among them.
+        let q = PointId::from_raw(5);
+        let mut ball = Vec::new();
+        w.ball(q, &mut ball);
+        assert!(!ball.is_empty());
+        let pos = w.m.points[q.idx()];
+        w.commit_move(q, [pos[0], pos[1], pos[2] + 0.01], &ball);
+        // Point 0 is on every tet, so tet 0 shares a corner with q's ball.
+        assert!(!w.move_idle(p) && !w.swap_idle(t));
+        // Marked again after the move, then a new point leaves it alone.
+        w.move_idle[p.idx()] = w.tick();
+        w.swap_idle[t as usize] = w.tick();
+        let n = w.push_point([5.0, 5.0, 5.0]);
+        assert!(w.move_idle(p) && w.swap_idle(t) && !w.move_idle(n));
     }
 }
