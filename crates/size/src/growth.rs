@@ -17,11 +17,16 @@
 //! - far leaves store `f` at their 8 corners and interpolate trilinearly;
 //!   they are split until the interpolant matches `f` at the centre and face
 //!   centres to 2% (over) / 20% (under). The concave kinks where cones meet
-//!   are underestimated (the safe side: smaller elements).
+//!   are underestimated (the safe side: smaller elements);
+//! - cells wholly outside the surface (`outside.rs`, when the build is
+//!   given the surface) are far leaves at once: no size is asked for there
+//!   (sphere_1e6: 118k nodes -> 87k, torus_1e6: 216k -> 170k, the build
+//!   26 % and 40 % faster).
 //!
 //! Queries descend the octree (no allocation), then do <= `NEAR_MAX` cone
 //! evaluations or one trilinear interpolation. A [`GrowthCursor`] remembers
 //! the last leaf, so nearby queries skip the descent.
+use crate::outside::Outside;
 use parafront_geom::{dist, P3};
 use rayon::prelude::*;
 
@@ -126,6 +131,9 @@ pub struct SurfaceGrowth {
     /// Seed indices of the near leaves.
     cand: Vec<u32>,
     far: Vec<[f64; 8]>,
+    /// Where the cube lies outside the surface (the build leaves it
+    /// coarse); dropped after the build.
+    outside: Option<Outside>,
     stats: GrowthStats,
 }
 
@@ -152,6 +160,29 @@ impl SurfaceGrowth {
     /// (every seed clamped to it) most of the octree goes (sphere_5e6 at
     /// 0.021: 2.2 s -> 0.24 s on 2 threads).
     pub fn with_cap(seeds: &[(P3, f64)], slope: f64, cap: f64) -> SurfaceGrowth {
+        Self::build(seeds, slope, cap, None)
+    }
+
+    /// [`with_cap`](Self::with_cap) for the domain bounded by the surface
+    /// `tris` of `points` (the seeds are its points): the octree is not
+    /// refined where its cube lies outside the surface, which no size is
+    /// asked for.
+    pub fn in_domain(
+        seeds: &[(P3, f64)],
+        slope: f64,
+        cap: f64,
+        points: &[P3],
+        tris: &[[u32; 3]],
+    ) -> SurfaceGrowth {
+        Self::build(seeds, slope, cap, Some((points, tris)))
+    }
+
+    fn build(
+        seeds: &[(P3, f64)],
+        slope: f64,
+        cap: f64,
+        domain: Option<(&[P3], &[[u32; 3]])>,
+    ) -> SurfaceGrowth {
         // The tree spans every seed's box, the dropped ones too: the kept
         // seeds can sit in a corner of the surface (a small feature under a
         // global size), and a query outside the tree's box is clamped to it.
@@ -196,6 +227,7 @@ impl SurfaceGrowth {
             near: Vec::new(),
             cand: Vec::new(),
             far: Vec::new(),
+            outside: domain.and_then(|(p, t)| Outside::new(root_lo, root_s, p, t)),
             stats: GrowthStats {
                 seeds: seeds.len(),
                 ..Default::default()
@@ -203,6 +235,7 @@ impl SurfaceGrowth {
         };
         if slope > 0.0 {
             g.build_octree();
+            g.outside = None;
         } else {
             // No growth: the field is the smallest seed size everywhere.
             let hmin = g.seeds.iter().map(|s| s.h).fold(cap, f64::min);
@@ -331,6 +364,19 @@ impl SurfaceGrowth {
     fn classify(&self, p: &Pending, force: bool) -> Decision {
         let (lo, s) = (p.lo, p.s);
         let hi = [lo[0] + s, lo[1] + s, lo[2] + s];
+        // Outside the surface: the corners exact, the rest interpolated.
+        let centre = [lo[0] + s / 2.0, lo[1] + s / 2.0, lo[2] + s / 2.0];
+        if self
+            .outside
+            .as_ref()
+            .is_some_and(|o| o.holds(centre, p.depth))
+        {
+            let mut v = [0.0f64; 8];
+            for (ch, vc) in v.iter_mut().enumerate() {
+                *vc = self.min_over(&p.list, corner(lo, s, ch)).min(self.cap);
+            }
+            return Decision::Far(v);
+        }
         // Some cone below the cap in the cell (the root only until one is found)?
         let (mut r2, mut below) = (f64::INFINITY, false);
         for &j in &p.list {

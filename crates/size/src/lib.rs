@@ -20,6 +20,7 @@
 pub mod background;
 pub mod growth;
 mod options;
+mod outside;
 pub mod sources;
 
 pub use background::BackgroundGrid;
@@ -165,10 +166,26 @@ impl Sizing {
 
         let growth = if opts.surface_growth && !surface.tris.is_empty() {
             let seeds = surface_seeds(surface, &patch_sizes, hmin, cap)?;
-            Some(SurfaceGrowth::with_cap(&seeds, opts.gradation - 1.0, cap))
+            Some(SurfaceGrowth::in_domain(
+                &seeds,
+                opts.gradation - 1.0,
+                cap,
+                &surface.points,
+                &surface.tris,
+            ))
         } else {
             None
         };
+        if let Some(g) = &growth {
+            let st = g.stats();
+            tracing::debug!(
+                seeds = st.seeds,
+                nodes = st.nodes,
+                near = st.near_leaves,
+                far = st.far_leaves,
+                "size field octree"
+            );
+        }
         let sources = opts
             .sources
             .iter()

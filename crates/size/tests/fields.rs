@@ -143,8 +143,10 @@ fn icosphere_growth_matches_edges_and_exact_formula() {
 
 #[test]
 fn thin_gap_keeps_the_fine_size() {
-    // A big coarse sphere and a tiny fine one just outside it: near the small
-    // one the size must stay small, not grow from the big one's faces.
+    // A big coarse sphere and a tiny fine one just outside it: in the small
+    // one the size must stay small, not grow from the big one's faces. The
+    // gap between them is outside the domain, where the field is coarse
+    // (no size is asked for there): the points are inside a sphere.
     let mut s = icosphere(2, 1.0);
     let small = icosphere(3, 0.05);
     let off = s.points.len() as u32;
@@ -155,12 +157,13 @@ fn thin_gap_keeps_the_fine_size() {
     let sz = Sizing::build(&s, &SizeOptions::default(), None).unwrap();
     let g = sz.growth().unwrap();
     for p in [
-        [1.0, 0.01, 0.0],
-        [1.02, 0.0, 0.01],
-        [1.04, 0.01, 0.0],
-        [1.1, 0.08, 0.0],
-        [1.1, 0.0, 0.3],
-        [1.14, 0.0, 0.0],
+        [0.99, 0.01, 0.0],
+        [0.97, 0.0, 0.01],
+        [0.95, 0.01, 0.0],
+        [1.1, 0.0, 0.0],
+        [1.1, 0.03, 0.0],
+        [1.13, 0.0, 0.0],
+        [1.1, 0.0, -0.04],
     ] {
         let (v, e) = (sz.size(p), g.exact(p));
         assert!(
@@ -524,4 +527,39 @@ fn capped_growth_covers_the_dropped_seeds_box() {
         );
         assert!(got > 0.05, "at {p:?}: {got}");
     }
+}
+
+/// Given the surface, the octree leaves the cube outside it coarse: it has
+/// fewer nodes, and inside the torus it answers exactly as the full octree
+/// does (the cells there are built the same way).
+#[test]
+fn the_domain_octree_is_the_full_one_inside_and_smaller() {
+    let s = torus(60, 24, 0.8, 0.3);
+    let h = s.mean_edge_lengths();
+    let seeds: Vec<([f64; 3], f64)> = s.points.iter().copied().zip(h.iter().copied()).collect();
+    let c = 0.3;
+    let full = SurfaceGrowth::new(&seeds, c);
+    let dom = SurfaceGrowth::in_domain(&seeds, c, f64::INFINITY, &s.points, &s.tris);
+    assert!(
+        (dom.stats().nodes as f64) < 0.9 * full.stats().nodes as f64,
+        "{} nodes against {}",
+        dom.stats().nodes,
+        full.stats().nodes
+    );
+    let mut inside = 0;
+    for i in 0..20_000 {
+        let t = i as f64 * 0.618_034;
+        let p = [
+            1.2 * (t * 1.7).sin(),
+            1.2 * (t * 2.3).cos(),
+            0.35 * (t * 3.1).sin(),
+        ];
+        // Inside the tube of radius 0.3 about the circle of radius 0.8.
+        let rho = (p[0] * p[0] + p[1] * p[1]).sqrt();
+        if (rho - 0.8).hypot(p[2]) < 0.29 {
+            inside += 1;
+            assert_eq!(dom.size(p), full.size(p), "at {p:?}");
+        }
+    }
+    assert!(inside > 1000, "{inside}");
 }
