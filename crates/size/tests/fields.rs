@@ -174,20 +174,59 @@ fn thin_gap_keeps_the_fine_size() {
     }
 }
 
+/// A point inside the torus `torus(60, 24, 0.8, 0.3)` (its tube radius
+/// 0.3 less the facets' sag), from tube coordinates in `[0, 1)`.
+fn in_torus(x: [f64; 3]) -> [f64; 3] {
+    let (u, v, r) = (
+        x[0] * std::f64::consts::TAU,
+        x[1] * std::f64::consts::TAU,
+        0.29 * x[2],
+    );
+    let rho = 0.8 + r * v.cos();
+    [rho * u.cos(), rho * u.sin(), r * v.sin()]
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(400))]
+    /// The octree over the whole cube (no surface given) is Lipschitz to
+    /// its tolerances everywhere.
     #[test]
     fn growth_is_lipschitz(a in prop::array::uniform3(-1.2f64..1.2), b in prop::array::uniform3(-1.2f64..1.2), t in 0.0f64..1.0) {
+        use std::sync::OnceLock;
+        static G: OnceLock<(SurfaceGrowth, f64)> = OnceLock::new();
+        let (g, c) = G.get_or_init(|| {
+            let s = torus(60, 24, 0.8, 0.3);
+            let h = s.mean_edge_lengths();
+            let seeds: Vec<([f64; 3], f64)> = s.points.iter().copied().zip(h.iter().copied()).collect();
+            let c = SizeOptions::default().gradation - 1.0;
+            (SurfaceGrowth::new(&seeds, c), c)
+        });
+        // Far pairs and close pairs (b pulled towards a).
+        let b2 = [a[0] + (b[0] - a[0]) * t * t, a[1] + (b[1] - a[1]) * t * t, a[2] + (b[2] - a[2]) * t * t];
+        for q in [b, b2] {
+            let (fa, fq) = (g.size(a), g.size(q));
+            let allowed = 1.5 * c * dist(a, q) + 0.02 * fa.max(fq);
+            prop_assert!((fa - fq).abs() <= allowed, "|f({:?})={} - f({:?})={}| > {}", a, fa, q, fq, allowed);
+        }
+    }
+
+    /// The size field of a surface is Lipschitz inside it, where the
+    /// fronts bound a new point's size from a neighbour's (outside, the
+    /// octree is coarse).
+    #[test]
+    fn the_size_field_is_lipschitz_inside(a in prop::array::uniform3(0.0f64..1.0), b in prop::array::uniform3(0.0f64..1.0), t in 0.0f64..1.0) {
         use std::sync::OnceLock;
         static SZ: OnceLock<Sizing> = OnceLock::new();
         let sz = SZ.get_or_init(|| Sizing::build(&torus(60, 24, 0.8, 0.3), &SizeOptions::default(), None).unwrap());
         let c = sz.gradation() - 1.0;
-        // Far pairs and close pairs (b pulled towards a).
+        // Far pairs and close pairs (b pulled towards a in tube
+        // coordinates, so that both stay inside).
         let b2 = [a[0] + (b[0] - a[0]) * t * t, a[1] + (b[1] - a[1]) * t * t, a[2] + (b[2] - a[2]) * t * t];
-        for q in [b, b2] {
-            let (fa, fq) = (sz.size(a), sz.size(q));
-            let allowed = 1.5 * c * dist(a, q) + 0.02 * fa.max(fq);
-            prop_assert!((fa - fq).abs() <= allowed, "|f({:?})={} - f({:?})={}| > {}", a, fa, q, fq, allowed);
+        let pa = in_torus(a);
+        for q in [in_torus(b), in_torus(b2)] {
+            let (fa, fq) = (sz.size(pa), sz.size(q));
+            let allowed = 1.5 * c * dist(pa, q) + 0.02 * fa.max(fq);
+            prop_assert!((fa - fq).abs() <= allowed, "|f({:?})={} - f({:?})={}| > {}", pa, fa, q, fq, allowed);
         }
     }
 }
