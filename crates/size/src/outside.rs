@@ -4,18 +4,21 @@
 //! (`growth.rs`) does not refine it.
 use parafront_geom::P3;
 
-/// Levels of the grid: `2^LEVELS` voxels per side, the octree's cells at
-/// that depth.
-const LEVELS: usize = 7;
-const N: usize = 1 << LEVELS;
+/// Levels of the grid, at most: `2^7` voxels per side, the octree's cells
+/// at that depth. A smaller surface gets a coarser grid, about 32 voxels
+/// per triangle (at least `2^4` per side): 128^3 took 30 ms, the whole run
+/// of a twisted prism 10.
+const MAX_LEVELS: usize = 7;
+const MIN_LEVELS: usize = 4;
 
 /// The voxels reached from the cube's border without meeting a triangle's
 /// box (grown by a voxel), and above them a pyramid: a cell of the octree
-/// at depth `d` lies outside when its cell at level `min(d, LEVELS)` does.
+/// at depth `d` lies outside when its cell at level `min(d, levels)` does.
 #[derive(Clone, Debug)]
 pub(crate) struct Outside {
     lo: P3,
     s: f64,
+    levels: usize,
     /// `out[d]`: the `(2^d)^3` cells at depth `d`, each wholly outside.
     out: Vec<Vec<bool>>,
 }
@@ -27,19 +30,22 @@ impl Outside {
         if tris.is_empty() || !(s > 0.0) {
             return None;
         }
-        let vs = s / N as f64;
+        let want = (32.0 * tris.len() as f64).cbrt().log2().ceil() as usize;
+        let levels = want.clamp(MIN_LEVELS, MAX_LEVELS);
+        let n_side = 1usize << levels;
+        let vs = s / n_side as f64;
         let cell = |x: f64, k: usize| -> usize {
             let c = ((x - lo[k]) / vs).floor();
             if c.is_nan() || c < 0.0 {
                 0
             } else {
-                (c as usize).min(N - 1)
+                (c as usize).min(n_side - 1)
             }
         };
-        let idx = |i: usize, j: usize, k: usize| (i * N + j) * N + k;
+        let idx = |i: usize, j: usize, k: usize| (i * n_side + j) * n_side + k;
         // A triangle's box, grown by one voxel on each side: float rounding
         // in `cell` can never leave a voxel it meets unmarked.
-        let mut near = vec![false; N * N * N];
+        let mut near = vec![false; n_side * n_side * n_side];
         for t in tris {
             let p = t.map(|v| points[v as usize]);
             let mut a = [0usize; 3];
@@ -48,7 +54,7 @@ impl Outside {
                 let mn = p[0][k].min(p[1][k]).min(p[2][k]);
                 let mx = p[0][k].max(p[1][k]).max(p[2][k]);
                 a[k] = cell(mn, k).saturating_sub(1);
-                b[k] = (cell(mx, k) + 1).min(N - 1);
+                b[k] = (cell(mx, k) + 1).min(n_side - 1);
             }
             for i in a[0]..=b[0] {
                 for j in a[1]..=b[1] {
@@ -59,12 +65,12 @@ impl Outside {
             }
         }
         // Flood from the border through voxels no triangle is near.
-        let mut out = vec![false; N * N * N];
+        let mut out = vec![false; n_side * n_side * n_side];
         let mut stack = Vec::new();
-        for i in 0..N {
-            for j in 0..N {
-                for k in 0..N {
-                    let border = [i, j, k].iter().any(|&c| c == 0 || c == N - 1);
+        for i in 0..n_side {
+            for j in 0..n_side {
+                for k in 0..n_side {
+                    let border = [i, j, k].iter().any(|&c| c == 0 || c == n_side - 1);
                     let v = idx(i, j, k);
                     if border && !near[v] && !out[v] {
                         out[v] = true;
@@ -79,7 +85,7 @@ impl Outside {
                 for up in [false, true] {
                     let mut n = c;
                     if up {
-                        if n[d] + 1 >= N {
+                        if n[d] + 1 >= n_side {
                             continue;
                         }
                         n[d] += 1;
@@ -97,10 +103,10 @@ impl Outside {
                 }
             }
         }
-        let mut levels = vec![out];
-        for d in (0..LEVELS).rev() {
+        let mut pyramid = vec![out];
+        for d in (0..levels).rev() {
             let n = 1usize << d;
-            let up = &levels[levels.len() - 1];
+            let up = &pyramid[pyramid.len() - 1];
             let mut cur = vec![false; n * n * n];
             for i in 0..n {
                 for j in 0..n {
@@ -113,16 +119,21 @@ impl Outside {
                     }
                 }
             }
-            levels.push(cur);
+            pyramid.push(cur);
         }
-        levels.reverse();
-        Some(Outside { lo, s, out: levels })
+        pyramid.reverse();
+        Some(Outside {
+            lo,
+            s,
+            levels,
+            out: pyramid,
+        })
     }
 
     /// Whether the octree's cell at depth `depth` around `centre` lies
     /// wholly outside.
     pub(crate) fn holds(&self, centre: P3, depth: u32) -> bool {
-        let d = (depth as usize).min(LEVELS);
+        let d = (depth as usize).min(self.levels);
         let n = 1usize << d;
         let cs = self.s / n as f64;
         let mut c = [0usize; 3];
