@@ -174,6 +174,15 @@ fn thin_gap_keeps_the_fine_size() {
     }
 }
 
+/// The torus `torus(60, 24, 0.8, 0.3)` and its points as seeds, each
+/// with its mean edge length.
+fn torus_seeds() -> (Surface, Vec<([f64; 3], f64)>) {
+    let s = torus(60, 24, 0.8, 0.3);
+    let h = s.mean_edge_lengths();
+    let seeds = s.points.iter().copied().zip(h).collect();
+    (s, seeds)
+}
+
 /// A point inside the torus `torus(60, 24, 0.8, 0.3)` (its tube radius
 /// 0.3 less the facets' sag), from tube coordinates in `[0, 1)`.
 fn in_torus(x: [f64; 3]) -> [f64; 3] {
@@ -195,9 +204,7 @@ proptest! {
         use std::sync::OnceLock;
         static G: OnceLock<(SurfaceGrowth, f64)> = OnceLock::new();
         let (g, c) = G.get_or_init(|| {
-            let s = torus(60, 24, 0.8, 0.3);
-            let h = s.mean_edge_lengths();
-            let seeds: Vec<([f64; 3], f64)> = s.points.iter().copied().zip(h.iter().copied()).collect();
+            let (_, seeds) = torus_seeds();
             let c = SizeOptions::default().gradation - 1.0;
             (SurfaceGrowth::new(&seeds, c), c)
         });
@@ -506,10 +513,8 @@ fn no_growth_is_the_smallest_surface_size() {
 /// what the cap hides: the seeds at the cap and the cells above it.
 #[test]
 fn a_capped_growth_is_the_capped_field_and_smaller() {
-    let s = torus(60, 24, 0.8, 0.3);
-    let h = s.mean_edge_lengths();
-    let seeds: Vec<([f64; 3], f64)> = s.points.iter().copied().zip(h.iter().copied()).collect();
-    let hmean = h.iter().sum::<f64>() / h.len() as f64;
+    let (_, seeds) = torus_seeds();
+    let hmean = seeds.iter().map(|s| s.1).sum::<f64>() / seeds.len() as f64;
     let c = 0.3;
     let full = SurfaceGrowth::new(&seeds, c);
     for cap in [0.9 * hmean, 1.5 * hmean, 4.0 * hmean] {
@@ -573,9 +578,7 @@ fn capped_growth_covers_the_dropped_seeds_box() {
 /// does (the cells there are built the same way).
 #[test]
 fn the_domain_octree_is_the_full_one_inside_and_smaller() {
-    let s = torus(60, 24, 0.8, 0.3);
-    let h = s.mean_edge_lengths();
-    let seeds: Vec<([f64; 3], f64)> = s.points.iter().copied().zip(h.iter().copied()).collect();
+    let (s, seeds) = torus_seeds();
     let c = 0.3;
     let full = SurfaceGrowth::new(&seeds, c);
     let dom = SurfaceGrowth::in_domain(&seeds, c, f64::INFINITY, &s.points, &s.tris);
