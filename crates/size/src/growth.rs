@@ -131,9 +131,6 @@ pub struct SurfaceGrowth {
     /// Seed indices of the near leaves.
     cand: Vec<u32>,
     far: Vec<[f64; 8]>,
-    /// Where the cube lies outside the surface (the build leaves it
-    /// coarse); dropped after the build.
-    outside: Option<Outside>,
     stats: GrowthStats,
 }
 
@@ -227,15 +224,15 @@ impl SurfaceGrowth {
             near: Vec::new(),
             cand: Vec::new(),
             far: Vec::new(),
-            outside: domain.and_then(|(p, t)| Outside::new(root_lo, root_s, p, t)),
             stats: GrowthStats {
                 seeds: seeds.len(),
                 ..Default::default()
             },
         };
         if slope > 0.0 {
-            g.build_octree();
-            g.outside = None;
+            // Where the cube lies outside the surface: left coarse.
+            let outside = domain.and_then(|(p, t)| Outside::new(root_lo, root_s, p, t));
+            g.build_octree(outside.as_ref());
         } else {
             // No growth: the field is the smallest seed size everywhere.
             let hmin = g.seeds.iter().map(|s| s.h).fold(cap, f64::min);
@@ -286,7 +283,7 @@ impl SurfaceGrowth {
         }
     }
 
-    fn build_octree(&mut self) {
+    fn build_octree(&mut self, outside: Option<&Outside>) {
         // Bounded memory whatever the input: past the cap every cell is a leaf.
         let cap = (32 * self.seeds.len() + 4096).min(1 << 28);
         // Depth first, a batch of cells at a time: breadth first held a whole
@@ -304,7 +301,7 @@ impl SurfaceGrowth {
             let pending = stack.split_off(stack.len().saturating_sub(BUILD_BATCH));
             let decisions: Vec<Decision> = pending
                 .par_iter()
-                .map(|p| self.classify(p, force || p.depth >= MAX_DEPTH))
+                .map(|p| self.classify(p, force || p.depth >= MAX_DEPTH, outside))
                 .collect();
             for (p, dec) in pending.into_iter().zip(decisions) {
                 self.stats.depth = self.stats.depth.max(p.depth);
@@ -361,16 +358,12 @@ impl SurfaceGrowth {
         Decision::Split(lists)
     }
 
-    fn classify(&self, p: &Pending, force: bool) -> Decision {
+    fn classify(&self, p: &Pending, force: bool, outside: Option<&Outside>) -> Decision {
         let (lo, s) = (p.lo, p.s);
         let hi = [lo[0] + s, lo[1] + s, lo[2] + s];
         // Outside the surface: the corners exact, the rest interpolated.
         let centre = [lo[0] + s / 2.0, lo[1] + s / 2.0, lo[2] + s / 2.0];
-        if self
-            .outside
-            .as_ref()
-            .is_some_and(|o| o.holds(centre, p.depth))
-        {
+        if outside.is_some_and(|o| o.holds(centre, p.depth)) {
             let mut v = [0.0f64; 8];
             for (ch, vc) in v.iter_mut().enumerate() {
                 *vc = self.min_over(&p.list, corner(lo, s, ch)).min(self.cap);

@@ -14,7 +14,6 @@ const MIN_LEVELS: usize = 4;
 /// The voxels reached from the cube's border without meeting a triangle's
 /// box (grown by a voxel), and above them a pyramid: a cell of the octree
 /// at depth `d` lies outside when its cell at level `min(d, levels)` does.
-#[derive(Clone, Debug)]
 pub(crate) struct Outside {
     lo: P3,
     s: f64,
