@@ -267,6 +267,11 @@ impl SurfaceGrowth {
         m
     }
 
+    /// The field `min(f, cap)` at `N` points ([`min_at`](Self::min_at)).
+    fn capped_at<const N: usize>(&self, list: &[u32], pts: &[P3; N]) -> [f64; N] {
+        self.min_at(list, pts).map(|f| f.min(self.cap))
+    }
+
     /// For each child `ch` of the cell `[lo, lo+2h]` (`corner(lo, h, ch)`),
     /// the seeds of `list` that can be the minimum somewhere in it: lower
     /// bound `h_j + c dist(x_j, child)` <= an upper bound of `f` on the
@@ -402,9 +407,9 @@ impl SurfaceGrowth {
         let hi = [lo[0] + s, lo[1] + s, lo[2] + s];
         // Outside the surface: the corners exact, the rest interpolated.
         let centre = [lo[0] + s / 2.0, lo[1] + s / 2.0, lo[2] + s / 2.0];
+        let corners: [P3; 8] = std::array::from_fn(|ch| corner(lo, s, ch));
         if outside.is_some_and(|o| o.holds(centre, p.depth)) {
-            let corners: [P3; 8] = std::array::from_fn(|ch| corner(lo, s, ch));
-            return Decision::Far(self.min_at(&p.list, &corners).map(|f| f.min(self.cap)));
+            return Decision::Far(self.capped_at(&p.list, &corners));
         }
         // Some cone below the cap in the cell (the root only until one is found)?
         let (mut r2, mut below) = (f64::INFINITY, false);
@@ -457,9 +462,8 @@ impl SurfaceGrowth {
             [0.5, 0.5, 0.0],
             [0.5, 0.5, 1.0],
         ];
-        let corners: [P3; 8] = std::array::from_fn(|ch| corner(lo, s, ch));
         if force {
-            return Decision::Far(self.min_at(&p.list, &corners).map(|f| f.min(self.cap)));
+            return Decision::Far(self.capped_at(&p.list, &corners));
         }
         let pts: [P3; 15] = std::array::from_fn(|i| match i {
             0..8 => corners[i],
@@ -468,7 +472,7 @@ impl SurfaceGrowth {
                 [lo[0] + t[0] * s, lo[1] + t[1] * s, lo[2] + t[2] * s]
             }
         });
-        let f = self.min_at(&p.list, &pts).map(|f| f.min(self.cap));
+        let f = self.capped_at(&p.list, &pts);
         let v: [f64; 8] = std::array::from_fn(|ch| f[ch]);
         for (k, t) in TESTS.into_iter().enumerate() {
             let (i, f) = (trilinear(&v, t), f[8 + k]);

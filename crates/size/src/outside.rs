@@ -153,28 +153,9 @@ mod tests {
 
     /// A closed box surface `[1, 3]^3` (12 triangles) in the cube `[0, 4]^3`.
     fn cube() -> (Vec<P3>, Vec<[u32; 3]>) {
-        let mut pts = Vec::new();
-        for i in 0..8 {
-            pts.push([
-                if i & 1 != 0 { 3.0 } else { 1.0 },
-                if i & 2 != 0 { 3.0 } else { 1.0 },
-                if i & 4 != 0 { 3.0 } else { 1.0 },
-            ]);
-        }
-        let q = [
-            [0, 2, 3, 1],
-            [4, 5, 7, 6],
-            [0, 1, 5, 4],
-            [2, 6, 7, 3],
-            [0, 4, 6, 2],
-            [1, 3, 7, 5],
-        ];
-        let mut tris = Vec::new();
-        for f in q {
-            tris.push([f[0], f[1], f[2]]);
-            tris.push([f[0], f[2], f[3]]);
-        }
-        (pts, tris)
+        let s = parafront_surface::generate::voxels([1.0; 3], 2.0, [1, 1, 1], |_, _, _| true);
+        assert_eq!(s.tris.len(), 12);
+        (s.points, s.tris)
     }
 
     #[test]
