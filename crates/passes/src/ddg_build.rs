@@ -293,7 +293,8 @@ const DDG_SERIAL_ROUNDS: [u32; 2] = [1, 12];
 /// growth `c` (the graded sizes of [`ddg::build`]): `passes` parallel
 /// passes on `comm.parts()` convex cells each, then the serial pass on
 /// what they left. The sizes are the DDG's own, from the front's edges
-/// (the fine mesh's sizes do not enter).
+/// (the fine mesh's sizes do not enter). Under MPI each process runs the
+/// passes of its own parts, and every process gets the whole DDG.
 pub fn build_ddg<C: Comm>(
     points: &[P3],
     faces: &[[u32; 3]],
@@ -325,11 +326,6 @@ pub(crate) fn build_ddg_at<C: Comm>(
 ) -> Result<(Ddg, DdgBuildStats), PassError> {
     let t_all = Instant::now();
     let np = comm.parts();
-    assert_eq!(
-        comm.owned(),
-        0..np,
-        "the passes hold every part in one process"
-    );
     let mut st = DdgBuildStats::default();
     let t0 = Instant::now();
     let first = if depth >= DEEP {
@@ -363,7 +359,7 @@ pub(crate) fn build_ddg_at<C: Comm>(
     let domain = Aabb::from_points(points.iter());
     let domain = domain.inflated(1e-6 * domain.diagonal().max(1e-300));
 
-    let mut parts = seed_parts(0..np, points, &point_size, faces);
+    let mut parts = seed_parts(comm.owned(), points, &point_size, faces);
     let mut next_gid = points.len() as u32;
     let debug = tracing::enabled!(tracing::Level::DEBUG);
     for j in 0..passes {
@@ -412,7 +408,11 @@ pub(crate) fn build_ddg_at<C: Comm>(
     st.pass_seconds.push(t0.elapsed().as_secs_f64());
 
     let t0 = Instant::now();
-    let (pts, tets, neigh) = merge_parts(parts, points.len(), next_gid as usize)?;
+    // Every process gets every part's tets (the DDG is replicated: each
+    // locates points in all of it), in part order, so the merge is the
+    // same bytes everywhere.
+    let all = comm.all_gather(parts.into_iter().map(|p| (p.gid, p.pts, p.tets)).collect());
+    let (pts, tets, neigh) = merge_parts(all, points.len(), next_gid as usize)?;
     st.merge_seconds = t0.elapsed().as_secs_f64();
     Ok((
         Ddg {
@@ -447,12 +447,16 @@ fn front_centroids<C: Comm>(parts: &[Part], comm: &C) -> Vec<P3> {
     .concat()
 }
 
-/// One mesh of the parts: the `n_input` input points first (their ids),
-/// then the new points (global ids below `n`) in order, those no tet uses
-/// left out; tets by part; and its adjacency.
+/// A part's points (global ids, positions) and tets (local ids), as the
+/// merge takes them from every process.
+type PartMesh = (Vec<u32>, Vec<P3>, Vec<[u32; 4]>);
+
+/// One mesh of the parts (every part, in part order): the `n_input` input
+/// points first (their ids), then the new points (global ids below `n`) in
+/// order, those no tet uses left out; tets by part; and its adjacency.
 #[allow(clippy::type_complexity)]
 fn merge_parts(
-    parts: Vec<Part>,
+    parts: Vec<PartMesh>,
     n_input: usize,
     n: usize,
 ) -> Result<(Vec<P3>, Vec<[u32; 4]>, Vec<parafront_mesh::FaceRef>), PassError> {
@@ -460,12 +464,12 @@ fn merge_parts(
     let mut used = vec![false; n];
     used[..n_input].iter_mut().for_each(|u| *u = true);
     let mut tets: Vec<[u32; 4]> = Vec::new();
-    for part in &parts {
-        for (i, &g) in part.gid.iter().enumerate() {
-            at[g as usize] = part.pts[i];
+    for (gid, ppts, ptets) in &parts {
+        for (i, &g) in gid.iter().enumerate() {
+            at[g as usize] = ppts[i];
         }
-        for t in &part.tets {
-            let tv = t.map(|i| part.gid[i as usize]);
+        for t in ptets {
+            let tv = t.map(|i| gid[i as usize]);
             for &g in &tv {
                 used[g as usize] = true;
             }

@@ -8,7 +8,8 @@
 //! this module and only ever touched by the closure of its own part); parts
 //! see each other's data only through the messages of a [`Comm`]. A
 //! process holds the parts `Comm::owned` gives (all of them with
-//! `Threads`, a block of them per rank under MPI); the DDG and its
+//! `Threads`, a block of them per rank under MPI); the DDG's passes run
+//! over the processes and every process then holds the whole DDG, its
 //! partitions are replicated, and pass 4 runs on part 0's process, whose
 //! choices reach the others by all-gather.
 #![forbid(unsafe_code)]
@@ -585,7 +586,8 @@ pub fn mesh_parallel_around<C: Comm>(
     if depth < opts.thin_depth {
         return Err(PassError::Thin { depth });
     }
-    // §5 step 1: the DDG (replicated: it is small).
+    // §5 step 1: the DDG (built over the processes, then held by each:
+    // it is small).
     let mut rec = Recorder::new(np);
     let t_ddg = Instant::now();
     // The surface's points only: the core's are no candidates for the DDG.
@@ -691,10 +693,9 @@ fn the_ddg<C: Comm>(
 ) -> Result<(Ddg, Option<DdgBuildStats>), PassError> {
     if opts.ddg_passes > 0 {
         let (c, passes, cap) = (opts.growth, opts.ddg_passes, opts.ddg_cap);
-        // Replicated: every process builds the whole DDG on its own threads
-        // (it is small, and the same bytes everywhere).
-        let local = parafront_comm::Threads::new(comm.parts());
-        match ddg_build::build_ddg_at(points, faces, depth, c, passes, cap, &local) {
+        // Its passes run over the processes like the fine mesh's; every
+        // process then holds the whole DDG (the same bytes everywhere).
+        match ddg_build::build_ddg_at(points, faces, depth, c, passes, cap, comm) {
             Ok((d, bs)) => return Ok((d, Some(bs))),
             // The serial front gets another go (deterministic: the same
             // failure on any thread count).
