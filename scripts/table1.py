@@ -104,7 +104,9 @@ def section(rows, a, where):
          f"## table1: {os.path.basename(a.surface)}, --parts {a.parts}, generation only\n",
          "nproc: MPI ranks, nprol: threads per rank. s: wall seconds of the slowest rank. "
          "AbsSpeed: tets per second; RelSpeed: per core. Speed-up over nproc = nprol = 1. "
-         "ddg: the DDG and its partition, built on every rank with its own threads. "
+         "ddg: the DDG and its partition (the DDG's passes run over the ranks from "
+         "commit e9c5944 on, before it every rank built the whole DDG; every rank "
+         "runs the partition). "
          "cpu s: all ranks' CPU seconds.\n",
          "| nproc | nprol | ncore | nelem | s | AbsSpeed | RelSpeed | speed-up | ddg s | pass 1 | "
          "pass 2 | pass 3 | pass 4 | ddg % of s | cpu s |",
