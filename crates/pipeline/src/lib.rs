@@ -10,6 +10,7 @@ mod parts;
 mod pieces;
 use parts::{finish_pieces, mesh_parts};
 mod regions;
+mod share;
 mod summary;
 
 pub use parafront_ddg::Partition;
@@ -377,7 +378,12 @@ fn mesh_surface_here<C: Comm>(
     sum.push(Stage::Validate, t0.elapsed().as_secs_f64());
 
     let t0 = Instant::now();
-    let sizing = Sizing::build(s, &opts.size, None)?;
+    // Over processes, each builds a share of the field's octree.
+    let sizing = if comm.owned().len() == comm.parts() {
+        Sizing::build(s, &opts.size, None)?
+    } else {
+        Sizing::build_shared(s, &opts.size, None, &share::CommShare(comm))?
+    };
     sum.push(Stage::SizeField, t0.elapsed().as_secs_f64());
     opts.release();
 

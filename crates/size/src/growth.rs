@@ -30,6 +30,7 @@
 //! evaluations or one trilinear interpolation. A [`GrowthCursor`] remembers
 //! the last leaf, so nearby queries skip the descent.
 use crate::outside::Outside;
+use crate::share::{Alone, OctreeShare, Subtree};
 use parafront_geom::{dist, P3};
 use rayon::prelude::*;
 
@@ -46,8 +47,10 @@ const TOL_UNDER: f64 = 0.2;
 /// more than this fraction (the seed bounding f on the child always stays).
 const PRUNE_EPS: f64 = 0.01;
 const MAX_DEPTH: u32 = 24;
-/// Cells classified at once (in parallel) by the build.
-const BUILD_BATCH: usize = 256;
+/// Cells the build's first phase leaves for the second, whose subtrees are
+/// built in parallel (and over processes): many more than threads, so
+/// that the uneven subtrees balance.
+const FRONTIER: usize = 512;
 
 const KIND_SHIFT: u32 = 30;
 const IDX_MASK: u32 = (1 << KIND_SHIFT) - 1;
@@ -70,6 +73,22 @@ fn point_box_d2(p: P3, lo: P3, hi: P3) -> f64 {
         d2 += e * e;
     }
     d2
+}
+
+/// The eight children of split cell `p`, their nodes from `first`, with
+/// their seed lists.
+fn children(p: &Pending, first: usize, lists: Vec<Vec<u32>>) -> impl Iterator<Item = Pending> + '_ {
+    let h = p.s / 2.0;
+    lists
+        .into_iter()
+        .enumerate()
+        .map(move |(ch, list)| Pending {
+            node: first + ch,
+            lo: corner(p.lo, h, ch),
+            s: h,
+            depth: p.depth + 1,
+            list,
+        })
 }
 
 enum Decision {
@@ -160,7 +179,7 @@ impl SurfaceGrowth {
     /// (every seed clamped to it) most of the octree goes (sphere_5e6 at
     /// 0.021: 2.2 s -> 0.24 s on 2 threads).
     pub fn with_cap(seeds: &[(P3, f64)], slope: f64, cap: f64) -> SurfaceGrowth {
-        Self::build(seeds, slope, cap, None)
+        Self::build(seeds, slope, cap, None, &Alone)
     }
 
     /// [`with_cap`](Self::with_cap) for the domain bounded by the surface
@@ -174,7 +193,20 @@ impl SurfaceGrowth {
         points: &[P3],
         tris: &[[u32; 3]],
     ) -> SurfaceGrowth {
-        Self::build(seeds, slope, cap, Some((points, tris)))
+        Self::in_domain_shared(seeds, slope, cap, points, tris, &Alone)
+    }
+
+    /// [`in_domain`](Self::in_domain), its octree's subtrees built where
+    /// `share` says (the same field on every process).
+    pub fn in_domain_shared(
+        seeds: &[(P3, f64)],
+        slope: f64,
+        cap: f64,
+        points: &[P3],
+        tris: &[[u32; 3]],
+        share: &dyn OctreeShare,
+    ) -> SurfaceGrowth {
+        Self::build(seeds, slope, cap, Some((points, tris)), share)
     }
 
     fn build(
@@ -182,6 +214,7 @@ impl SurfaceGrowth {
         slope: f64,
         cap: f64,
         domain: Option<(&[P3], &[[u32; 3]])>,
+        share: &dyn OctreeShare,
     ) -> SurfaceGrowth {
         // The tree spans every seed's box, the dropped ones too: the kept
         // seeds can sit in a corner of the surface (a small feature under a
@@ -235,7 +268,7 @@ impl SurfaceGrowth {
         if slope > 0.0 {
             // Where the cube lies outside the surface: left coarse.
             let outside = domain.and_then(|(p, t)| Outside::new(root_lo, root_s, p, t));
-            g.build_octree(outside.as_ref());
+            g.build_octree(outside.as_ref(), share);
         } else {
             // No growth: the field is the smallest seed size everywhere.
             let hmin = g.seeds.iter().map(|s| s.h).fold(cap, f64::min);
@@ -336,27 +369,30 @@ impl SurfaceGrowth {
         out
     }
 
-    fn build_octree(&mut self, outside: Option<&Outside>) {
-        // Bounded memory whatever the input: past the cap every cell is a leaf.
+    /// The octree in two phases: breadth first to a frontier of about
+    /// [`FRONTIER`] cells, the same on every process, then the frontier's
+    /// subtrees, each depth first on its own, shared out by `share` and
+    /// stitched in frontier order. A cell's decision depends on the cell
+    /// alone (until a node cap binds), so the field is the same however the
+    /// subtrees are shared.
+    fn build_octree(&mut self, outside: Option<&Outside>, share: &dyn OctreeShare) {
+        // Bounded memory whatever the input: past the cap every cell is a
+        // leaf (phase 2 gives each subtree a share of it).
         let cap = (32 * self.seeds.len() + 4096).min(1 << 28);
-        // Depth first, a batch of cells at a time: breadth first held a whole
-        // level's lists at once (200 MB for torus_1e6's 32k seeds, the run's
-        // peak), a stack holds about seven batches per level.
-        let mut stack = vec![Pending {
+        let mut level = vec![Pending {
             node: 0,
             lo: self.root_lo,
             s: self.root_s,
             depth: 0,
             list: (0..self.seeds.len() as u32).collect(),
         }];
-        while !stack.is_empty() {
-            let force = self.nodes.len() > cap;
-            let pending = stack.split_off(stack.len().saturating_sub(BUILD_BATCH));
-            let decisions: Vec<Decision> = pending
+        while !level.is_empty() && level.len() < FRONTIER {
+            let decisions: Vec<Decision> = level
                 .par_iter()
-                .map(|p| self.classify(p, force || p.depth >= MAX_DEPTH, outside))
+                .map(|p| self.classify(p, p.depth >= MAX_DEPTH, outside))
                 .collect();
-            for (p, dec) in pending.into_iter().zip(decisions) {
+            let mut next = Vec::new();
+            for (p, dec) in level.into_iter().zip(decisions) {
                 self.stats.depth = self.stats.depth.max(p.depth);
                 match dec {
                     Decision::Near(list) => {
@@ -372,19 +408,26 @@ impl SurfaceGrowth {
                         let first = self.nodes.len();
                         self.nodes[p.node] = first as u32;
                         self.nodes.extend_from_slice(&[0; 8]);
-                        let h = p.s / 2.0;
-                        for (ch, list) in lists.into_iter().enumerate() {
-                            stack.push(Pending {
-                                node: first + ch,
-                                lo: corner(p.lo, h, ch),
-                                s: h,
-                                depth: p.depth + 1,
-                                list,
-                            });
-                        }
+                        next.extend(children(&p, first, lists));
                     }
                 }
             }
+            level = next;
+        }
+        let n = level.len();
+        let mine: Vec<(u32, Subtree)> = level
+            .par_iter()
+            .enumerate()
+            .filter(|(i, _)| share.builds(*i, n))
+            .map(|(i, p)| {
+                let cap_i = 32 * p.list.len() + cap / n + 4096;
+                (i as u32, self.subtree(p, outside, cap_i))
+            })
+            .collect();
+        let subs = share.gather(mine, n);
+        assert_eq!(subs.len(), n, "every subtree of the frontier");
+        for (p, sub) in level.iter().zip(subs) {
+            self.stitch(p.node, sub);
         }
         let st = &mut self.stats;
         st.nodes = self.nodes.len();
@@ -396,6 +439,68 @@ impl SurfaceGrowth {
             + self.cand.len() * 4
             + self.far.len() * 64
             + self.seeds.len() * 32;
+    }
+
+    /// The subtree under frontier cell `root`, depth first, at most about
+    /// `cap` nodes before every cell is a leaf.
+    fn subtree(&self, root: &Pending, outside: Option<&Outside>, cap: usize) -> Subtree {
+        let mut t = Subtree {
+            nodes: vec![0],
+            ..Default::default()
+        };
+        let mut stack = vec![Pending {
+            node: 0,
+            lo: root.lo,
+            s: root.s,
+            depth: root.depth,
+            list: root.list.clone(),
+        }];
+        while let Some(p) = stack.pop() {
+            let force = t.nodes.len() > cap || p.depth >= MAX_DEPTH;
+            t.depth = t.depth.max(p.depth);
+            match self.classify(&p, force, outside) {
+                Decision::Near(list) => {
+                    t.nodes[p.node] = (K_NEAR << KIND_SHIFT) | t.near.len() as u32;
+                    t.near.push((t.cand.len() as u32, list.len() as u32));
+                    t.cand.extend_from_slice(&list);
+                }
+                Decision::Far(v) => {
+                    t.nodes[p.node] = (K_FAR << KIND_SHIFT) | t.far.len() as u32;
+                    t.far.push(v);
+                }
+                Decision::Split(lists) => {
+                    let first = t.nodes.len();
+                    t.nodes[p.node] = first as u32;
+                    t.nodes.extend_from_slice(&[0; 8]);
+                    stack.extend(children(&p, first, lists));
+                }
+            }
+        }
+        t
+    }
+
+    /// Subtree `sub` in place of frontier node `node`: its nodes after the
+    /// octree's (its local node `j > 0` at `base + j - 1`), its lists after
+    /// the octree's.
+    fn stitch(&mut self, node: usize, sub: Subtree) {
+        let base = self.nodes.len() as u32;
+        let (near0, cand0, far0) = (
+            self.near.len() as u32,
+            self.cand.len() as u32,
+            self.far.len() as u32,
+        );
+        let remap = |code: u32| match code >> KIND_SHIFT {
+            K_INTERNAL => base + code - 1,
+            K_NEAR => (K_NEAR << KIND_SHIFT) | ((code & IDX_MASK) + near0),
+            _ => (K_FAR << KIND_SHIFT) | ((code & IDX_MASK) + far0),
+        };
+        self.nodes[node] = remap(sub.nodes[0]);
+        self.nodes.extend(sub.nodes[1..].iter().map(|&c| remap(c)));
+        self.near
+            .extend(sub.near.iter().map(|&(a, l)| (a + cand0, l)));
+        self.cand.extend_from_slice(&sub.cand);
+        self.far.extend_from_slice(&sub.far);
+        self.stats.depth = self.stats.depth.max(sub.depth);
     }
 
     fn split(&self, p: &Pending, eps: f64) -> Decision {

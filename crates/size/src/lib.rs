@@ -21,11 +21,13 @@ pub mod background;
 pub mod growth;
 mod options;
 mod outside;
+mod share;
 pub mod sources;
 
 pub use background::BackgroundGrid;
 pub use growth::{GrowthCursor, GrowthStats, SurfaceGrowth};
 pub use options::{SizeOptions, SourceSpec, DEFAULT_GRADATION};
+pub use share::{Alone, OctreeShare, Subtree, SubtreeParts};
 pub use sources::Source;
 
 use parafront_geom::{dist, P3};
@@ -144,6 +146,18 @@ impl Sizing {
         opts: &SizeOptions,
         background: Option<(TetMesh, Vec<f64>)>,
     ) -> Result<Sizing, SizeError> {
+        Sizing::build_shared(surface, opts, background, &Alone)
+    }
+
+    /// [`build`](Self::build) with the surface field's octree shared out
+    /// by `share` (each MPI rank builds some of its subtrees); the same
+    /// field whatever the share.
+    pub fn build_shared(
+        surface: &Surface,
+        opts: &SizeOptions,
+        background: Option<(TetMesh, Vec<f64>)>,
+        share: &dyn OctreeShare,
+    ) -> Result<Sizing, SizeError> {
         opts.validate()?;
         let cap = opts.cap();
         let hmin = opts.hmin;
@@ -166,12 +180,13 @@ impl Sizing {
 
         let growth = if opts.surface_growth && !surface.tris.is_empty() {
             let seeds = surface_seeds(surface, &patch_sizes, hmin, cap)?;
-            Some(SurfaceGrowth::in_domain(
+            Some(SurfaceGrowth::in_domain_shared(
                 &seeds,
                 opts.gradation - 1.0,
                 cap,
                 &surface.points,
                 &surface.tris,
+                share,
             ))
         } else {
             None
