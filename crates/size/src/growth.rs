@@ -426,6 +426,11 @@ impl SurfaceGrowth {
             .collect();
         let subs = share.gather(mine, n);
         assert_eq!(subs.len(), n, "every subtree of the frontier");
+        let total = |f: fn(&Subtree) -> usize| subs.iter().map(f).sum::<usize>();
+        self.nodes.reserve_exact(total(|t| t.nodes.len()));
+        self.near.reserve_exact(total(|t| t.near.len()));
+        self.cand.reserve_exact(total(|t| t.cand.len()));
+        self.far.reserve_exact(total(|t| t.far.len()));
         for (p, sub) in level.iter().zip(subs) {
             self.stitch(p.node, sub);
         }
