@@ -1,8 +1,10 @@
 //! `mpirun -n R parafront mesh SURFACE --parts P` (feature `mpi`): rank `r`
 //! holds the parts `r*P/R .. (r+1)*P/R` and runs their passes on its own
-//! `--threads`. Every rank reads the surface and builds the size field and
-//! the DDG (small; the same bytes everywhere); the mesh gathers on rank 0,
-//! which improves, checks and writes it and prints the summary.
+//! `--threads`. Every rank reads the surface; the size field's octree and
+//! the DDG are built over the ranks and then held by each (small; the same
+//! bytes everywhere). With `-o x.vtu` or `.msh` the mesh gathers on rank 0,
+//! which improves, checks and writes it and prints the summary; with
+//! `-o x.pvtu` it stays in its pieces.
 use crate::{Fail, MeshArgs, WriteArgs};
 use parafront_comm::{Comm, Mpi};
 use parafront_surface::Surface;
