@@ -75,6 +75,32 @@ fn point_box_d2(p: P3, lo: P3, hi: P3) -> f64 {
     d2
 }
 
+impl Subtree {
+    /// Cell `node`'s decision: a leaf's entry, or a block of eight child
+    /// nodes (their first index and seed lists, to push).
+    fn record(&mut self, node: usize, dec: Decision) -> Option<(usize, Vec<Vec<u32>>)> {
+        match dec {
+            Decision::Near(list) => {
+                self.nodes[node] = (K_NEAR << KIND_SHIFT) | self.near.len() as u32;
+                self.near.push((self.cand.len() as u32, list.len() as u32));
+                self.cand.extend_from_slice(&list);
+                None
+            }
+            Decision::Far(v) => {
+                self.nodes[node] = (K_FAR << KIND_SHIFT) | self.far.len() as u32;
+                self.far.push(v);
+                None
+            }
+            Decision::Split(lists) => {
+                let first = self.nodes.len();
+                self.nodes[node] = first as u32;
+                self.nodes.extend_from_slice(&[0; 8]);
+                Some((first, lists))
+            }
+        }
+    }
+}
+
 /// The eight children of split cell `p`, their nodes from `first`, with
 /// their seed lists.
 fn children(p: &Pending, first: usize, lists: Vec<Vec<u32>>) -> impl Iterator<Item = Pending> + '_ {
@@ -379,6 +405,11 @@ impl SurfaceGrowth {
         // Bounded memory whatever the input: past the cap every cell is a
         // leaf (phase 2 gives each subtree a share of it).
         let cap = (32 * self.seeds.len() + 4096).min(1 << 28);
+        // Phase 1's nodes, which the subtrees then hang from.
+        let mut top = Subtree {
+            nodes: vec![0],
+            ..Default::default()
+        };
         let mut level = vec![Pending {
             node: 0,
             lo: self.root_lo,
@@ -393,23 +424,9 @@ impl SurfaceGrowth {
                 .collect();
             let mut next = Vec::new();
             for (p, dec) in level.into_iter().zip(decisions) {
-                self.stats.depth = self.stats.depth.max(p.depth);
-                match dec {
-                    Decision::Near(list) => {
-                        self.nodes[p.node] = (K_NEAR << KIND_SHIFT) | self.near.len() as u32;
-                        self.near.push((self.cand.len() as u32, list.len() as u32));
-                        self.cand.extend_from_slice(&list);
-                    }
-                    Decision::Far(v) => {
-                        self.nodes[p.node] = (K_FAR << KIND_SHIFT) | self.far.len() as u32;
-                        self.far.push(v);
-                    }
-                    Decision::Split(lists) => {
-                        let first = self.nodes.len();
-                        self.nodes[p.node] = first as u32;
-                        self.nodes.extend_from_slice(&[0; 8]);
-                        next.extend(children(&p, first, lists));
-                    }
+                top.depth = top.depth.max(p.depth);
+                if let Some((first, lists)) = top.record(p.node, dec) {
+                    next.extend(children(&p, first, lists));
                 }
             }
             level = next;
@@ -426,6 +443,11 @@ impl SurfaceGrowth {
             .collect();
         let subs = share.gather(mine, n);
         assert_eq!(subs.len(), n, "every subtree of the frontier");
+        self.nodes = top.nodes;
+        self.near = top.near;
+        self.cand = top.cand;
+        self.far = top.far;
+        self.stats.depth = top.depth;
         let total = |f: fn(&Subtree) -> usize| subs.iter().map(f).sum::<usize>();
         self.nodes.reserve_exact(total(|t| t.nodes.len()));
         self.near.reserve_exact(total(|t| t.near.len()));
@@ -463,22 +485,8 @@ impl SurfaceGrowth {
         while let Some(p) = stack.pop() {
             let force = t.nodes.len() > cap || p.depth >= MAX_DEPTH;
             t.depth = t.depth.max(p.depth);
-            match self.classify(&p, force, outside) {
-                Decision::Near(list) => {
-                    t.nodes[p.node] = (K_NEAR << KIND_SHIFT) | t.near.len() as u32;
-                    t.near.push((t.cand.len() as u32, list.len() as u32));
-                    t.cand.extend_from_slice(&list);
-                }
-                Decision::Far(v) => {
-                    t.nodes[p.node] = (K_FAR << KIND_SHIFT) | t.far.len() as u32;
-                    t.far.push(v);
-                }
-                Decision::Split(lists) => {
-                    let first = t.nodes.len();
-                    t.nodes[p.node] = first as u32;
-                    t.nodes.extend_from_slice(&[0; 8]);
-                    stack.extend(children(&p, first, lists));
-                }
+            if let Some((first, lists)) = t.record(p.node, self.classify(&p, force, outside)) {
+                stack.extend(children(&p, first, lists));
             }
         }
         t
