@@ -378,12 +378,9 @@ fn mesh_surface_here<C: Comm>(
     sum.push(Stage::Validate, t0.elapsed().as_secs_f64());
 
     let t0 = Instant::now();
-    // Over processes, each builds a share of the field's octree.
-    let sizing = if comm.owned().len() == comm.parts() {
-        Sizing::build(s, &opts.size, None)?
-    } else {
-        Sizing::build_shared(s, &opts.size, None, &share::CommShare(comm))?
-    };
+    // Each process builds its parts' share of the field's octree (one
+    // process: all of it).
+    let sizing = Sizing::build_shared(s, &opts.size, None, &share::CommShare(comm))?;
     sum.push(Stage::SizeField, t0.elapsed().as_secs_f64());
     opts.release();
 

@@ -1,6 +1,7 @@
 //! The size field's octree shared out over processes (MPI ranks): part
 //! `i % P` builds subtree `i`, and every process gets every subtree by an
-//! all-gather, so each holds the field a single process builds.
+//! all-gather, so each holds the field a single process builds. One
+//! process (the threads backend) holds every part and builds them all.
 use parafront_comm::Comm;
 use parafront_size::{OctreeShare, Subtree, SubtreeParts};
 

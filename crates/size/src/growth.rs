@@ -432,8 +432,11 @@ impl SurfaceGrowth {
             level = next;
         }
         let n = level.len();
+        let frontier: Vec<usize> = level.iter().map(|p| p.node).collect();
+        // Each frontier cell's list goes to its subtree's build, and is
+        // freed with it (or at once, where another process builds it).
         let mine: Vec<(u32, Subtree)> = level
-            .par_iter()
+            .into_par_iter()
             .enumerate()
             .filter(|(i, _)| share.builds(*i, n))
             .map(|(i, p)| {
@@ -453,8 +456,8 @@ impl SurfaceGrowth {
         self.near.reserve_exact(total(|t| t.near.len()));
         self.cand.reserve_exact(total(|t| t.cand.len()));
         self.far.reserve_exact(total(|t| t.far.len()));
-        for (p, sub) in level.iter().zip(subs) {
-            self.stitch(p.node, sub);
+        for (node, sub) in frontier.into_iter().zip(subs) {
+            self.stitch(node, sub);
         }
         let st = &mut self.stats;
         st.nodes = self.nodes.len();
@@ -470,18 +473,12 @@ impl SurfaceGrowth {
 
     /// The subtree under frontier cell `root`, depth first, at most about
     /// `cap` nodes before every cell is a leaf.
-    fn subtree(&self, root: &Pending, outside: Option<&Outside>, cap: usize) -> Subtree {
+    fn subtree(&self, root: Pending, outside: Option<&Outside>, cap: usize) -> Subtree {
         let mut t = Subtree {
             nodes: vec![0],
             ..Default::default()
         };
-        let mut stack = vec![Pending {
-            node: 0,
-            lo: root.lo,
-            s: root.s,
-            depth: root.depth,
-            list: root.list.clone(),
-        }];
+        let mut stack = vec![Pending { node: 0, ..root }];
         while let Some(p) = stack.pop() {
             let force = t.nodes.len() > cap || p.depth >= MAX_DEPTH;
             t.depth = t.depth.max(p.depth);
