@@ -6,6 +6,7 @@ use parafront_geom::{orient3d, Aabb, P3};
 use std::sync::atomic::{AtomicU32, Ordering};
 
 /// A uniform grid of boxes (CSR cells), shared by the tet and face lookups.
+/// It keeps no boxes: the caller has them, or recomputes them.
 #[derive(Clone, Debug)]
 struct Bins {
     min: P3,
@@ -13,78 +14,72 @@ struct Bins {
     n: [usize; 3],
     start: Vec<u32>,
     list: Vec<u32>,
-    boxes: Vec<Aabb>,
 }
 
 impl Bins {
-    /// About `per_cell` boxes per cell on average.
-    fn new(boxes: Vec<Aabb>, per_cell: f64) -> Bins {
+    /// The `n` boxes `bx(i)`, about `per_cell` of them per cell on average.
+    fn new(n: usize, bx: impl Fn(usize) -> Aabb, per_cell: f64) -> Bins {
         let mut bb = Aabb::EMPTY;
-        for b in &boxes {
-            bb = bb.union(b);
+        for i in 0..n {
+            bb = bb.union(&bx(i));
         }
-        if boxes.is_empty() {
+        if n == 0 {
             return Bins {
                 min: [0.0; 3],
                 inv: 1.0,
                 n: [1, 1, 1],
                 start: vec![0, 0],
                 list: Vec::new(),
-                boxes,
             };
         }
         let ext = [0, 1, 2].map(|k| (bb.max[k] - bb.min[k]).max(1e-300));
         let vol = ext[0] * ext[1] * ext[2];
-        let cells = (boxes.len() as f64 / per_cell).clamp(1.0, 4e6);
+        let cells = (n as f64 / per_cell).clamp(1.0, 4e6);
         let mut cell = (vol / cells).cbrt();
         let maxe = ext.iter().cloned().fold(0.0, f64::max);
         cell = cell.max(maxe / 512.0);
-        let n = ext.map(|e| ((e / cell).ceil() as usize).clamp(1, 512));
+        let nc = ext.map(|e| ((e / cell).ceil() as usize).clamp(1, 512));
         let inv = 1.0 / cell;
         let min = bb.min;
-        let ncell = n[0] * n[1] * n[2];
-        let mut count = vec![0u32; ncell + 1];
+        let ncell = nc[0] * nc[1] * nc[2];
         let range = |b: &Aabb| {
             let lo = [0, 1, 2]
-                .map(|k| (((b.min[k] - min[k]) * inv).floor().max(0.0) as usize).min(n[k] - 1));
+                .map(|k| (((b.min[k] - min[k]) * inv).floor().max(0.0) as usize).min(nc[k] - 1));
             let hi = [0, 1, 2]
-                .map(|k| (((b.max[k] - min[k]) * inv).floor().max(0.0) as usize).min(n[k] - 1));
+                .map(|k| (((b.max[k] - min[k]) * inv).floor().max(0.0) as usize).min(nc[k] - 1));
             (lo, hi)
         };
-        for b in &boxes {
+        let cells_of = |b: &Aabb, f: &mut dyn FnMut(usize)| {
             let (lo, hi) = range(b);
             for i in lo[0]..=hi[0] {
                 for j in lo[1]..=hi[1] {
                     for k in lo[2]..=hi[2] {
-                        count[(k * n[1] + j) * n[0] + i + 1] += 1;
+                        f((k * nc[1] + j) * nc[0] + i);
                     }
                 }
             }
+        };
+        let mut count = vec![0u32; ncell + 1];
+        for x in 0..n {
+            cells_of(&bx(x), &mut |c| count[c + 1] += 1);
         }
         for c in 0..ncell {
             count[c + 1] += count[c];
         }
         let mut fill = count.clone();
         let mut list = vec![0u32; count[ncell] as usize];
-        for (x, b) in boxes.iter().enumerate() {
-            let (lo, hi) = range(b);
-            for i in lo[0]..=hi[0] {
-                for j in lo[1]..=hi[1] {
-                    for k in lo[2]..=hi[2] {
-                        let c = (k * n[1] + j) * n[0] + i;
-                        list[fill[c] as usize] = x as u32;
-                        fill[c] += 1;
-                    }
-                }
-            }
+        for x in 0..n {
+            cells_of(&bx(x), &mut |c| {
+                list[fill[c] as usize] = x as u32;
+                fill[c] += 1;
+            });
         }
         Bins {
             min,
             inv,
-            n,
+            n: nc,
             start: count,
             list,
-            boxes,
         }
     }
 
@@ -100,6 +95,7 @@ impl Bins {
         Some((c[2] * self.n[1] + c[1]) * self.n[0] + c[0])
     }
 
+    /// The ids binned in the cell of `p`, ascending.
     fn at(&self, p: P3) -> &[u32] {
         match self.cell_of(p) {
             Some(c) => &self.list[self.start[c] as usize..self.start[c + 1] as usize],
@@ -107,7 +103,7 @@ impl Bins {
         }
     }
 
-    /// Calls `f` on every box id whose cell range meets `b` (with repeats).
+    /// Calls `f` on every id whose cell range meets `b` (with repeats).
     fn visit(&self, b: &Aabb, mut f: impl FnMut(u32) -> bool) -> bool {
         let lo = [0, 1, 2].map(|k| ((b.min[k] - self.min[k]) * self.inv).floor());
         let hi = [0, 1, 2].map(|k| ((b.max[k] - self.min[k]) * self.inv).floor());
@@ -125,7 +121,7 @@ impl Bins {
                 for i in l[0]..=h[0] {
                     let c = (k * self.n[1] + j) * self.n[0] + i;
                     for &x in &self.list[self.start[c] as usize..self.start[c + 1] as usize] {
-                        if self.boxes[x as usize].overlaps(b) && !f(x) {
+                        if !f(x) {
                             return false;
                         }
                     }
@@ -134,75 +130,128 @@ impl Bins {
         }
         true
     }
+
+    fn heap_bytes(&self) -> usize {
+        4 * (self.start.capacity() + self.list.capacity())
+    }
+}
+
+/// DDG tets per bin on average: at 0.5 the bins are 1.6 times larger and
+/// the queries no faster.
+const PER_CELL: f64 = 1.0;
+
+/// The largest f32 at or below `x` (finite `x`).
+fn f32_below(x: f64) -> f32 {
+    let y = x as f32;
+    if y as f64 <= x {
+        y
+    } else if y == 0.0 {
+        -f32::from_bits(1)
+    } else if y > 0.0 {
+        f32::from_bits(y.to_bits() - 1)
+    } else {
+        f32::from_bits(y.to_bits() + 1)
+    }
+}
+
+/// The smallest f32 at or above `x` (finite `x`).
+fn f32_above(x: f64) -> f32 {
+    -f32_below(-x)
+}
+
+/// Whether the closed tet `q` holds `p`: `Some(true)` strictly inside (then
+/// it is its only host), `Some(false)` on its boundary, `None` outside. A
+/// corner is on the boundary without a predicate (the surface points are
+/// corners of DDG tets, and every predicate of a corner takes the slow
+/// exact path); else no sub-tet with `p` in place of a corner may be
+/// negative.
+#[inline]
+fn holds(q: &[P3; 4], p: P3) -> Option<bool> {
+    if q.contains(&p) {
+        return Some(false);
+    }
+    let mut strict = true;
+    for k in 0..4 {
+        let mut r = *q;
+        r[k] = p;
+        let o = orient3d(r[0], r[1], r[2], r[3]);
+        if o < 0.0 {
+            return None;
+        }
+        strict &= o > 0.0;
+    }
+    Some(strict)
 }
 
 /// Which DDG tets hold a point (closed tets, exact predicates).
 ///
-/// The tets by point id (16 B each) rather than by their corners (96 B):
-/// every process holds a locator, and on sphere_5e6's DDG the corners
-/// were 17 MB of it.
+/// It borrows the DDG, keeps the tets' boxes in f32 and bins them one tet
+/// per cell on average: every process holds a locator through the passes,
+/// and on sphere_5e6's DDG (184k tets) copies, f64 boxes and finer bins
+/// were 34 MB of each MPI rank's 125 MB heap (now 18 MB).
 #[derive(Clone, Debug)]
-pub struct Locator {
+pub struct Locator<'a> {
     bins: Bins,
-    points: Vec<P3>,
-    tets: Vec<[u32; 4]>,
+    /// Each tet's box, rounded outwards to f32: `[min, max]`.
+    boxes: Vec<[[f32; 3]; 2]>,
+    d: &'a Ddg,
 }
 
-impl Locator {
+impl<'a> Locator<'a> {
     /// Bins the tets of `d`.
-    pub fn new(d: &Ddg) -> Locator {
+    pub fn new(d: &'a Ddg) -> Locator<'a> {
+        let bins = Bins::new(
+            d.tets.len(),
+            |t| Aabb::from_points(d.tet_points(t).iter()),
+            PER_CELL,
+        );
         let boxes = (0..d.tets.len())
-            .map(|t| Aabb::from_points(d.tet_points(t).iter()))
+            .map(|t| {
+                let b = Aabb::from_points(d.tet_points(t).iter());
+                [b.min.map(f32_below), b.max.map(f32_above)]
+            })
             .collect();
-        Locator {
-            bins: Bins::new(boxes, 0.5),
-            points: d.points.clone(),
-            tets: d.tets.clone(),
-        }
+        Locator { bins, boxes, d }
+    }
+
+    /// Bytes the locator holds beside the DDG.
+    pub fn heap_bytes(&self) -> usize {
+        self.bins.heap_bytes() + 24 * self.boxes.capacity()
+    }
+
+    /// Whether the box of tet `t` holds `p`.
+    #[inline]
+    fn in_box(&self, t: u32, p: P3) -> bool {
+        let [lo, hi] = &self.boxes[t as usize];
+        (0..3).all(|k| lo[k] as f64 <= p[k] && p[k] <= hi[k] as f64)
+    }
+
+    #[inline]
+    fn corners(&self, t: u32) -> [P3; 4] {
+        self.d.tets[t as usize].map(|v| self.d.points[v as usize])
     }
 
     /// Calls `f` with every DDG tet whose closure holds `p`, ascending;
     /// stops early when `f` returns false.
     pub fn hosts(&self, p: P3, mut f: impl FnMut(u32) -> bool) {
         for &t in self.bins.at(p) {
-            if !self.bins.boxes[t as usize].contains(p) {
-                continue;
-            }
-            if self.holds(t, p).is_some() && !f(t) {
+            if self.in_box(t, p) && holds(&self.corners(t), p).is_some() && !f(t) {
                 return;
             }
         }
     }
 
-    /// Whether the closed tet `t` holds `p`: `Some(true)` strictly inside
-    /// (then `t` is its only host), `Some(false)` on its boundary, `None`
-    /// outside. A corner is on the boundary without a predicate (the
-    /// surface points are corners of DDG tets, and every predicate of a
-    /// corner takes the slow exact path); else no sub-tet with `p` in
-    /// place of a corner may be negative.
-    #[inline]
-    fn holds(&self, t: u32, p: P3) -> Option<bool> {
-        let q = self.tets[t as usize].map(|v| self.points[v as usize]);
-        if q.contains(&p) {
-            return Some(false);
-        }
-        let mut strict = true;
-        for k in 0..4 {
-            let mut r = q;
-            r[k] = p;
-            let o = orient3d(r[0], r[1], r[2], r[3]);
-            if o < 0.0 {
-                return None;
-            }
-            strict &= o > 0.0;
-        }
-        Some(strict)
-    }
-
     /// Whether `p` lies strictly inside tet `t`: then `t` is its only host.
     #[inline]
     pub fn strictly_holds(&self, t: u32, p: P3) -> bool {
-        self.holds(t, p) == Some(true)
+        holds(&self.corners(t), p) == Some(true)
+    }
+
+    /// Whether `t` is a tet id (a hint may be `u32::MAX`) that holds `p`
+    /// strictly.
+    #[inline]
+    fn holds_alone(&self, t: u32, p: P3) -> bool {
+        (t as usize) < self.boxes.len() && self.in_box(t, p) && self.strictly_holds(t, p)
     }
 
     /// [`Locator::owner`], trying first the tet in `hint` (the last one
@@ -211,10 +260,7 @@ impl Locator {
     /// not depend on the hint.
     pub fn owner_near(&self, p: P3, part: &[u32], hint: &AtomicU32) -> Option<u32> {
         let h = hint.load(Ordering::Relaxed);
-        if (h as usize) < self.tets.len()
-            && self.bins.boxes[h as usize].contains(p)
-            && self.strictly_holds(h, p)
-        {
+        if self.holds_alone(h, p) {
             return Some(part[h as usize]);
         }
         // One scan of the bin: a tet that holds `p` strictly is its only
@@ -224,10 +270,10 @@ impl Locator {
         let mut first = u32::MAX;
         let mut hosts = 0;
         for &t in self.bins.at(p) {
-            if !self.bins.boxes[t as usize].contains(p) {
+            if !self.in_box(t, p) {
                 continue;
             }
-            match self.holds(t, p) {
+            match holds(&self.corners(t), p) {
                 None => {}
                 Some(true) => {
                     hint.store(t, Ordering::Relaxed);
@@ -281,14 +327,29 @@ impl Locator {
     }
 
     /// The lowest part among the DDG tets touching `p` (§8), or `None`
-    /// outside the DDG.
-    pub fn lowest_host(&self, p: P3, part: &[u32]) -> Option<u32> {
+    /// outside the DDG. `hint` is a tet near `p` (or `u32::MAX`), updated
+    /// to the last host found: the answer does not depend on it.
+    pub fn lowest_host(&self, p: P3, part: &[u32], hint: &mut u32) -> Option<u32> {
+        if self.holds_alone(*hint, p) {
+            return Some(part[*hint as usize]);
+        }
         let mut lo: Option<u32> = None;
-        self.hosts(p, |t| {
-            let k = part[t as usize];
-            lo = Some(lo.map_or(k, |l| l.min(k)));
-            true
-        });
+        for &t in self.bins.at(p) {
+            if !self.in_box(t, p) {
+                continue;
+            }
+            match holds(&self.corners(t), p) {
+                None => {}
+                Some(true) => {
+                    *hint = t;
+                    return Some(part[t as usize]);
+                }
+                Some(false) => {
+                    let k = part[t as usize];
+                    lo = Some(lo.map_or(k, |l| l.min(k)));
+                }
+            }
+        }
         lo
     }
 }
@@ -299,6 +360,7 @@ impl Locator {
 #[derive(Clone, Debug)]
 pub struct Interfaces {
     bins: Bins,
+    boxes: Vec<Aabb>,
     faces: Vec<[P3; 3]>,
     sides: Vec<[u32; 2]>,
 }
@@ -327,9 +389,10 @@ impl Interfaces {
                 sides.push([part[t], part[u]]);
             }
         }
-        let boxes = faces.iter().map(|f| Aabb::from_points(f.iter())).collect();
+        let boxes: Vec<Aabb> = faces.iter().map(|f| Aabb::from_points(f.iter())).collect();
         Interfaces {
-            bins: Bins::new(boxes, 1.0),
+            bins: Bins::new(boxes.len(), |i| boxes[i], 1.0),
+            boxes,
             faces,
             sides,
         }
@@ -340,6 +403,9 @@ impl Interfaces {
         let mut bb = Aabb { min: a, max: a };
         bb.grow(b);
         !self.bins.visit(&bb, |x| {
+            if !self.boxes[x as usize].overlaps(&bb) {
+                return true;
+            }
             let s = self.sides[x as usize];
             if s[0] != k && s[1] != k {
                 return true;
@@ -355,7 +421,7 @@ impl Interfaces {
 /// an edge must not cross a wall of the part.
 pub struct PartFilter<'a> {
     /// Locates points in the DDG.
-    pub loc: &'a Locator,
+    pub loc: &'a Locator<'a>,
     /// The walls between parts.
     pub walls: &'a Interfaces,
     /// The partition (DDG tet -> part).
@@ -368,7 +434,7 @@ pub struct PartFilter<'a> {
 
 impl<'a> PartFilter<'a> {
     /// The filter of part `k` of partition `part`, with its walls.
-    pub fn new(loc: &'a Locator, walls: &'a Interfaces, part: &'a [u32], k: u32) -> Self {
+    pub fn new(loc: &'a Locator<'a>, walls: &'a Interfaces, part: &'a [u32], k: u32) -> Self {
         PartFilter {
             loc,
             walls,
@@ -385,5 +451,119 @@ impl RegionFilter for PartFilter<'_> {
     }
     fn edge_ok(&self, a: P3, b: P3) -> bool {
         !self.walls.crosses(self.k, a, b)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use parafront_surface::generate;
+
+    /// The DDG of a torus: not convex, so points of its box fall outside.
+    fn torus_ddg() -> Ddg {
+        let s = generate::torus([0.0; 3], 1.0, 0.35, 24, 12);
+        let faces: Vec<[u32; 3]> = s.tris.iter().map(|t| [t[0], t[2], t[1]]).collect();
+        let h = s.mean_edge_lengths();
+        crate::build(s.points.clone(), h, faces, crate::DEFAULT_GROWTH).unwrap()
+    }
+
+    /// Every tet whose closure holds `p`, ascending, by a scan of all tets.
+    fn brute(d: &Ddg, p: P3) -> Vec<u32> {
+        (0..d.tets.len() as u32)
+            .filter(|&t| holds(&d.tet_points(t as usize), p).is_some())
+            .collect()
+    }
+
+    /// Inside points, corners, edge midpoints, face centroids and points of
+    /// the torus' box, in a scrambled order.
+    fn probes(d: &Ddg) -> Vec<P3> {
+        let mut out = d.points.clone();
+        let mut x = 0x9e37_79b9_7f4a_7c15u64;
+        let mut rnd = move || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            (x >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for t in 0..d.tets.len() {
+            let q = d.tet_points(t);
+            let mid = |a: P3, b: P3| [0, 1, 2].map(|k| 0.5 * (a[k] + b[k]));
+            out.push(mid(q[0], q[1]));
+            out.push([0, 1, 2].map(|k| (q[1][k] + q[2][k] + q[3][k]) / 3.0));
+            let w = [rnd(), rnd(), rnd(), rnd()];
+            let s: f64 = w.iter().sum();
+            out.push([0, 1, 2].map(|k| (0..4).map(|i| w[i] / s * q[i][k]).sum()));
+            out.push([0, 1, 2].map(|k| [1.4, 1.4, 0.4][k] * (2.0 * rnd() - 1.0)));
+        }
+        for i in (1..out.len()).rev() {
+            out.swap(i, (rnd() * (i + 1) as f64) as usize % (i + 1));
+        }
+        out
+    }
+
+    #[test]
+    fn the_locator_finds_every_host_a_scan_finds() {
+        let d = torus_ddg();
+        let loc = Locator::new(&d);
+        let part: Vec<u32> = (0..d.tets.len() as u32).map(|t| (t / 7) % 5).collect();
+        let hint = AtomicU32::new(u32::MAX);
+        let mut lo_hint = u32::MAX;
+        let (mut inside, mut outside, mut shared) = (0, 0, 0);
+        for p in probes(&d) {
+            let want = brute(&d, p);
+            let mut got = Vec::new();
+            loc.hosts(p, |t| {
+                got.push(t);
+                true
+            });
+            assert_eq!(got, want, "hosts of {p:?}");
+            let parts: Vec<u32> = want.iter().map(|&t| part[t as usize]).collect();
+            let one = parts.first().filter(|&&k| parts.iter().all(|&j| j == k));
+            assert_eq!(loc.owner(p, &part), one.copied(), "owner of {p:?}");
+            assert_eq!(
+                loc.owner_near(p, &part, &hint),
+                one.copied(),
+                "owner_near {p:?}"
+            );
+            let lowest = parts.iter().min().copied();
+            assert_eq!(
+                loc.lowest_host(p, &part, &mut lo_hint),
+                lowest,
+                "lowest {p:?}"
+            );
+            // A point strictly inside a tet is in no other tet's closure.
+            for &t in &want {
+                assert!(!loc.strictly_holds(t, p) || want.len() == 1, "{p:?}");
+            }
+            match want.len() {
+                0 => outside += 1,
+                1 => inside += 1,
+                _ => shared += 1,
+            }
+        }
+        // The probes reach all three cases.
+        assert!(
+            inside > 100 && outside > 100 && shared > 100,
+            "{inside} {outside} {shared}"
+        );
+    }
+
+    #[test]
+    fn outward_f32_rounding_brackets_the_value() {
+        for x in [
+            0.0,
+            1e-300,
+            -1e-300,
+            0.1,
+            -0.1,
+            1.0 / 3.0,
+            -2.5e7 / 3.0,
+            1e39,
+            -1e39,
+        ] {
+            assert!(f32_below(x) as f64 <= x && x <= f32_above(x) as f64, "{x}");
+        }
+        assert_eq!(f32_below(0.5), 0.5);
+        assert_eq!(f32_above(-0.25), -0.25);
     }
 }

@@ -347,6 +347,9 @@ pub(crate) fn metis_kway(
             }
         }
     }
+    // The f64 temporaries go before METIS runs: its own work space is
+    // the largest allocation of the partition.
+    drop(fw);
     let etot: f64 = ew.iter().sum();
     let escale = if etot > (1u64 << 29) as f64 {
         (1u64 << 29) as f64 / etot
@@ -354,6 +357,7 @@ pub(crate) fn metis_kway(
         1.0
     };
     let adjwgt = metis_weights(&ew, escale);
+    drop(ew);
     let contig = components(d, &vec![0u32; n], 1)[0] == 1;
     let mut part = vec![0i32; n];
     let res = {

@@ -523,7 +523,7 @@ pub(crate) trait Regions: Sync {
 /// The regions of one DDG partition.
 struct DdgRegions<'a> {
     d: &'a Ddg,
-    loc: &'a Locator,
+    loc: &'a Locator<'a>,
     walls: Interfaces,
     part_of: &'a [u32],
 }
@@ -718,26 +718,23 @@ fn the_ddg<C: Comm>(
 
 /// §6 step 2: the DDG's locator, its tet weights and the balanced split
 /// into `np` parts, with their statistics.
-fn split_ddg(
-    d: &Ddg,
+fn split_ddg<'d>(
+    d: &'d Ddg,
     size: &(dyn Fn(P3) -> f64 + Sync),
     opts: &ParOptions,
     np: usize,
     rec: &mut Recorder,
-) -> (Locator, Vec<f64>, Vec<u32>) {
+) -> (Locator<'d>, Vec<f64>, Vec<u32>) {
     let st = &mut rec.st;
     let t0 = Instant::now();
-    // The locator alongside: METIS runs on one thread.
-    let (loc, (w, part0, t_w, t_split)) = rayon::join(
-        || Locator::new(d),
-        || {
-            let w = ddg::tet_weights(d, size);
-            let t_w = t0.elapsed().as_secs_f64();
-            let t1 = Instant::now();
-            let part0 = ddg::partition(d, &w, size, np, opts.partition);
-            (w, part0, t_w, t1.elapsed().as_secs_f64())
-        },
-    );
+    let w = ddg::tet_weights(d, size);
+    let t_w = t0.elapsed().as_secs_f64();
+    let t1 = Instant::now();
+    let part0 = ddg::partition(d, &w, size, np, opts.partition);
+    let t_split = t1.elapsed().as_secs_f64();
+    // The locator after METIS, not beside it: METIS's work space is gone
+    // by then (on sphere_5e6 both together set each MPI rank's peak).
+    let loc = Locator::new(d);
     st.split_seconds = t_split;
     let t_rcb = t0.elapsed().as_secs_f64();
     st.predicted_imbalance = ddg::imbalance(&part0, &w, np);
@@ -752,7 +749,8 @@ fn split_ddg(
     rec.partitioned();
     if tracing::enabled!(tracing::Level::DEBUG) {
         tracing::debug!(
-            "partition: weights {t_w:.3} s, split {t_split:.3} s (with the locator {t_rcb:.3} s)"
+            "partition: weights {t_w:.3} s, split {t_split:.3} s (with the locator {t_rcb:.3} s, {:.1} MB)",
+            loc.heap_bytes() as f64 * 1e-6
         );
     }
     (loc, w, part0)

@@ -205,6 +205,7 @@ fn send_tets(
         .map(|(i, part)| {
             let k = start + i;
             let mut host: Vec<Option<u32>> = vec![None; part.pts.len()];
+            let mut hint = u32::MAX;
             let dst: Vec<u32> = part
                 .tets
                 .iter()
@@ -212,7 +213,7 @@ fn send_tets(
                     tv.iter()
                         .map(|&i| {
                             *host[i as usize].get_or_insert_with(|| {
-                                loc.lowest_host(part.pts[i as usize], part0)
+                                loc.lowest_host(part.pts[i as usize], part0, &mut hint)
                                     .unwrap_or(k as u32)
                             })
                         })

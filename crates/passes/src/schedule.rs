@@ -111,7 +111,7 @@ impl Partitions {
 /// the fine size field, the options and the parts' messages.
 pub(crate) struct Passes<'a, C: Comm> {
     pub(crate) d: &'a Ddg,
-    pub(crate) loc: &'a Locator,
+    pub(crate) loc: &'a Locator<'a>,
     pub(crate) w: &'a [f64],
     pub(crate) size: &'a (dyn Fn(P3) -> f64 + Sync),
     pub(crate) opts: &'a ParOptions,
