@@ -385,7 +385,14 @@ fn mesh_surface_here<C: Comm>(
     opts.release();
 
     let t0 = Instant::now();
-    let mut mesh = surface_mesh(s);
+    // The merged mesh starts from the surface where it is made: not on the
+    // processes that only send their parts, nor anywhere in pieces mode.
+    let merged_here = opts.parts < 2 || (opts.gather && comm.holds(0));
+    let mut mesh = if merged_here {
+        surface_mesh(s)
+    } else {
+        TetMesh::default()
+    };
     let lattice_inner = if opts.parts > 1 {
         let inner = mesh_parts(
             s,
