@@ -3,6 +3,7 @@ use crate::Ddg;
 use parafront_front::RegionFilter;
 use parafront_geom::intersect::{segment_triangle, SegTri};
 use parafront_geom::{orient3d, Aabb, P3};
+use rayon::prelude::*;
 use std::sync::atomic::{AtomicU32, Ordering};
 
 /// A uniform grid of boxes (CSR cells), shared by the tet and face lookups.
@@ -23,9 +24,9 @@ impl Bins {
     /// the cell, so that a point binned there by rounding is inside it.
     fn new<K>(
         n: usize,
-        bx: impl Fn(usize) -> Aabb,
-        prep: impl Fn(usize, f64) -> K,
-        keep: impl Fn(&K, &Aabb) -> bool,
+        bx: impl Fn(usize) -> Aabb + Sync,
+        prep: impl Fn(usize, f64) -> K + Sync,
+        keep: impl Fn(&K, &Aabb) -> bool + Sync,
         per_cell: f64,
     ) -> Bins {
         let mut bb = Aabb::EMPTY;
@@ -78,20 +79,42 @@ impl Bins {
                 }
             }
         };
+        // Each chunk of items finds its cells in parallel (the cell tests
+        // are the cost), in item order; then one counting sort by cell
+        // keeps each cell's items ascending.
+        const CHUNK: usize = 4096;
+        let found: Vec<(Vec<u32>, Vec<u32>)> = (0..n.div_ceil(CHUNK))
+            .into_par_iter()
+            .map(|ch| {
+                let (mut cells, mut per) = (Vec::new(), Vec::new());
+                for x in ch * CHUNK..((ch + 1) * CHUNK).min(n) {
+                    let before = cells.len();
+                    cells_of(x, &mut |c| cells.push(c as u32));
+                    per.push((cells.len() - before) as u32);
+                }
+                (cells, per)
+            })
+            .collect();
         let mut count = vec![0u32; ncell + 1];
-        for x in 0..n {
-            cells_of(x, &mut |c| count[c + 1] += 1);
+        for (cells, _) in &found {
+            for &c in cells {
+                count[c as usize + 1] += 1;
+            }
         }
         for c in 0..ncell {
             count[c + 1] += count[c];
         }
         let mut fill = count.clone();
         let mut list = vec![0u32; count[ncell] as usize];
-        for x in 0..n {
-            cells_of(x, &mut |c| {
-                list[fill[c] as usize] = x as u32;
-                fill[c] += 1;
-            });
+        for (ch, (cells, per)) in found.iter().enumerate() {
+            let mut at = 0;
+            for (i, &m) in per.iter().enumerate() {
+                for &c in &cells[at..at + m as usize] {
+                    list[fill[c as usize] as usize] = (ch * CHUNK + i) as u32;
+                    fill[c as usize] += 1;
+                }
+                at += m as usize;
+            }
         }
         Bins {
             min,
