@@ -323,11 +323,27 @@ impl<'a> Locator<'a> {
     /// Calls `f` with every DDG tet whose closure holds `p`, ascending;
     /// stops early when `f` returns false.
     pub fn hosts(&self, p: P3, mut f: impl FnMut(u32) -> bool) {
+        if let Some(t) = self.scan(p, &mut f) {
+            f(t);
+        }
+    }
+
+    /// One scan of the bin of `p`: a tet that holds `p` strictly (then its
+    /// only host), or `None` after calling `on_face` with each tet that
+    /// holds it on its boundary, ascending, until `on_face` returns false.
+    fn scan(&self, p: P3, mut on_face: impl FnMut(u32) -> bool) -> Option<u32> {
         for &t in self.bins.at(p) {
-            if self.in_box(t, p) && holds(&self.corners(t), p).is_some() && !f(t) {
-                return;
+            if !self.in_box(t, p) {
+                continue;
+            }
+            match holds(&self.corners(t), p) {
+                None => {}
+                Some(true) => return Some(t),
+                Some(false) if !on_face(t) => return None,
+                Some(false) => {}
             }
         }
+        None
     }
 
     /// Whether `p` lies strictly inside tet `t`: then `t` is its only host.
@@ -352,38 +368,9 @@ impl<'a> Locator<'a> {
         if self.holds_alone(h, p) {
             return Some(part[h as usize]);
         }
-        // One scan of the bin: a tet that holds `p` strictly is its only
-        // host (the common case, answered there); else every host must be
-        // in one part.
-        let mut own: Option<u32> = None;
-        let mut first = u32::MAX;
-        let mut hosts = 0;
-        for &t in self.bins.at(p) {
-            if !self.in_box(t, p) {
-                continue;
-            }
-            match holds(&self.corners(t), p) {
-                None => {}
-                Some(true) => {
-                    hint.store(t, Ordering::Relaxed);
-                    return Some(part[t as usize]);
-                }
-                Some(false) => {
-                    hosts += 1;
-                    let k = part[t as usize];
-                    match own {
-                        None => {
-                            own = Some(k);
-                            first = t;
-                        }
-                        Some(o) if o == k => {}
-                        Some(_) => return None,
-                    }
-                }
-            }
-        }
-        if hosts == 1 {
-            hint.store(first, Ordering::Relaxed);
+        let (own, remember) = self.one_part(p, part);
+        if let Some(t) = remember {
+            hint.store(t, Ordering::Relaxed);
         }
         own
     }
@@ -392,13 +379,23 @@ impl<'a> Locator<'a> {
     /// DDG tet touching `p` belongs to part `k`; `None` on an inter-part
     /// boundary or outside the DDG.
     pub fn owner(&self, p: P3, part: &[u32]) -> Option<u32> {
+        self.one_part(p, part).0
+    }
+
+    /// [`Locator::owner`], with the tet worth trying first next time: the
+    /// host of `p` when it has one host only.
+    fn one_part(&self, p: P3, part: &[u32]) -> (Option<u32>, Option<u32>) {
+        // A tet that holds `p` strictly is its only host (the common case);
+        // else every host must be in one part.
         let mut own: Option<u32> = None;
-        let mut mixed = false;
-        self.hosts(p, |t| {
+        let (mut first, mut hosts, mut mixed) = (u32::MAX, 0, false);
+        let strict = self.scan(p, |t| {
+            hosts += 1;
             let k = part[t as usize];
             match own {
                 None => {
                     own = Some(k);
+                    first = t;
                     true
                 }
                 Some(o) if o == k => true,
@@ -408,36 +405,29 @@ impl<'a> Locator<'a> {
                 }
             }
         });
-        if mixed {
-            None
-        } else {
-            own
+        match strict {
+            Some(t) => (Some(part[t as usize]), Some(t)),
+            None if mixed => (None, None),
+            None => (own, (hosts == 1).then_some(first)),
         }
     }
 
     /// The lowest part among the DDG tets touching `p` (§8), or `None`
     /// outside the DDG. `hint` is a tet near `p` (or `u32::MAX`), updated
-    /// to the last host found: the answer does not depend on it.
+    /// to the tet found holding `p` strictly: the answer does not depend
+    /// on it.
     pub fn lowest_host(&self, p: P3, part: &[u32], hint: &mut u32) -> Option<u32> {
         if self.holds_alone(*hint, p) {
             return Some(part[*hint as usize]);
         }
         let mut lo: Option<u32> = None;
-        for &t in self.bins.at(p) {
-            if !self.in_box(t, p) {
-                continue;
-            }
-            match holds(&self.corners(t), p) {
-                None => {}
-                Some(true) => {
-                    *hint = t;
-                    return Some(part[t as usize]);
-                }
-                Some(false) => {
-                    let k = part[t as usize];
-                    lo = Some(lo.map_or(k, |l| l.min(k)));
-                }
-            }
+        if let Some(t) = self.scan(p, |t| {
+            let k = part[t as usize];
+            lo = Some(lo.map_or(k, |l| l.min(k)));
+            true
+        }) {
+            *hint = t;
+            return Some(part[t as usize]);
         }
         lo
     }

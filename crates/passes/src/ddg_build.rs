@@ -359,14 +359,7 @@ pub(crate) fn build_ddg_at<C: Comm>(
     let domain = Aabb::from_points(points.iter());
     let domain = domain.inflated(1e-6 * domain.diagonal().max(1e-300));
 
-    let mut parts = seed_parts(
-        comm.owned(),
-        comm.parts(),
-        false,
-        points,
-        &point_size,
-        faces,
-    );
+    let mut parts = seed_parts(comm.owned(), 1, points, &point_size, faces);
     let mut next_gid = points.len() as u32;
     let debug = tracing::enabled!(tracing::Level::DEBUG);
     for j in 0..passes {

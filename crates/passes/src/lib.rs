@@ -347,21 +347,21 @@ struct Part {
     stuck: Vec<u32>,
 }
 
-/// The parts `owned` holds, with the input front: on part 0 (the reader)
-/// where `spread` is false, else in `np` blocks of consecutive faces, one
-/// a part, so that no process routes the whole front in pass 1 (on
-/// sphere_5e6 at 4 ranks, part 0's faces and their copies for the parts
-/// their boxes meet were 45 MB on rank 0 alone). Pass 1 sends them out.
+/// The parts `owned` holds, with the input front in `holders` blocks of
+/// consecutive faces on parts `0..holders`. The DDG's passes seed part 0
+/// only (the reader); the fine passes seed every part, so that no process
+/// routes the whole front in pass 1 (on sphere_5e6 at 4 ranks, part 0's
+/// faces and their copies for the parts their boxes meet were 45 MB on
+/// rank 0 alone). Pass 1 sends them out.
 fn seed_parts(
     owned: std::ops::Range<usize>,
-    np: usize,
-    spread: bool,
+    holders: usize,
     points: &[P3],
     point_size: &[f64],
     faces: &[[u32; 3]],
 ) -> Vec<Part> {
     let mut parts: Vec<Part> = owned.clone().map(|_| Part::default()).collect();
-    let holders = if spread { np.max(1) } else { 1 };
+    let holders = holders.max(1);
     for k in owned.clone().filter(|&k| k < holders) {
         let part = &mut parts[k - owned.start];
         let block = k * faces.len() / holders..(k + 1) * faces.len() / holders;
@@ -618,7 +618,7 @@ pub fn mesh_parallel_around<C: Comm>(
         all = faces.iter().chain(core).copied().collect();
         &all[..]
     };
-    let mut parts = seed_parts(comm.owned(), np, true, points, point_size, faces);
+    let mut parts = seed_parts(comm.owned(), np, points, point_size, faces);
     let mut next_gid = points.len() as u32;
     if core.is_empty() {
         rec.st.seeds = seed_inner_parts(
@@ -855,18 +855,13 @@ mod seed_tests {
 
     /// The input front as global ids, part by part, from the parts of
     /// every holder in `ranks` (ranges of part ids).
-    fn seeded(
-        ranks: &[std::ops::Range<usize>],
-        np: usize,
-        spread: bool,
-        n: u32,
-    ) -> Vec<Vec<[u32; 3]>> {
+    fn seeded(ranks: &[std::ops::Range<usize>], holders: usize, n: u32) -> Vec<Vec<[u32; 3]>> {
         let points: Vec<P3> = (0..n + 2).map(|i| [i as f64, 0.0, 0.0]).collect();
         let size = vec![1.0; points.len()];
         let faces: Vec<[u32; 3]> = (0..n).map(|i| [i, i + 1, i + 2]).collect();
         let mut out = Vec::new();
         for r in ranks {
-            for p in seed_parts(r.clone(), np, spread, &points, &size, &faces) {
+            for p in seed_parts(r.clone(), holders, &points, &size, &faces) {
                 assert_eq!(p.check(), Ok(()));
                 out.push(
                     p.front
@@ -883,13 +878,13 @@ mod seed_tests {
     fn spread_seeding_gives_each_part_a_block_in_face_order() {
         let all: Vec<[u32; 3]> = (0..101).map(|i| [i, i + 1, i + 2]).collect();
         // One process or three: the same blocks, every face once, in order.
-        let one = seeded(std::slice::from_ref(&(0..8)), 8, true, 101);
-        let three = seeded(&[0..3, 3..6, 6..8], 8, true, 101);
+        let one = seeded(std::slice::from_ref(&(0..8)), 8, 101);
+        let three = seeded(&[0..3, 3..6, 6..8], 8, 101);
         assert_eq!(one, three);
         assert_eq!(one.concat(), all);
         assert!(one.iter().all(|b| (12..=13).contains(&b.len())), "{one:?}");
-        // Not spread: all on part 0.
-        let held = seeded(&[0..3, 3..8], 8, false, 101);
+        // One holder: all on part 0.
+        let held = seeded(&[0..3, 3..8], 1, 101);
         assert_eq!(held[0], all);
         assert!(held[1..].iter().all(Vec::is_empty));
     }
