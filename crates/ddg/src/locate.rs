@@ -1,6 +1,6 @@
 //! Point location in the DDG and the region filter of one part (§7).
 use crate::Ddg;
-use parafront_front::RegionFilter;
+use parafront_front::{RegionFilter, NO_PLACE};
 use parafront_geom::intersect::{segment_triangle, SegTri};
 use parafront_geom::{orient3d, Aabb, P3};
 use rayon::prelude::*;
@@ -364,15 +364,61 @@ impl<'a> Locator<'a> {
     /// points near each other, mostly inside one DDG tet. The answer does
     /// not depend on the hint.
     pub fn owner_near(&self, p: P3, part: &[u32], hint: &AtomicU32) -> Option<u32> {
+        self.owner_placed(p, part, hint).0
+    }
+
+    /// The tet that holds `p` strictly, found by walking from tet `t`
+    /// through face neighbours towards `p` (across the first face that has
+    /// `p` outside), over at most `steps` tets; `None` where the walk ends
+    /// otherwise: on a face, outside the DDG or out of steps.
+    pub(crate) fn walk(&self, mut t: u32, p: P3, steps: usize) -> Option<u32> {
+        for _ in 0..steps {
+            if t as usize >= self.boxes.len() {
+                return None;
+            }
+            let q = self.corners(t);
+            let mut strict = true;
+            let mut exit = None;
+            for k in 0..4 {
+                // Face k is opposite corner k.
+                let mut r = q;
+                r[k] = p;
+                let o = orient3d(r[0], r[1], r[2], r[3]);
+                if o < 0.0 {
+                    exit = Some(k);
+                    break;
+                }
+                strict &= o > 0.0;
+            }
+            let Some(k) = exit else {
+                return strict.then_some(t);
+            };
+            let n = self.d.neigh[4 * t as usize + k];
+            if n.is_none() {
+                return None;
+            }
+            t = n.tet().idx() as u32;
+        }
+        None
+    }
+
+    /// [`Locator::owner_near`], and the tet that holds `p` strictly when
+    /// one does.
+    pub fn owner_placed(
+        &self,
+        p: P3,
+        part: &[u32],
+        hint: &AtomicU32,
+    ) -> (Option<u32>, Option<u32>) {
         let h = hint.load(Ordering::Relaxed);
         if self.holds_alone(h, p) {
-            return Some(part[h as usize]);
+            return (Some(part[h as usize]), Some(h));
         }
-        let (own, remember) = self.one_part(p, part);
+        let (own, remember, strict) = self.one_part(p, part);
         if let Some(t) = remember {
             hint.store(t, Ordering::Relaxed);
         }
-        own
+        (own, remember.filter(|_| strict))
     }
 
     /// The part that holds `p` conservatively (§7): `Some(k)` when every
@@ -382,9 +428,10 @@ impl<'a> Locator<'a> {
         self.one_part(p, part).0
     }
 
-    /// [`Locator::owner`], with the tet worth trying first next time: the
-    /// host of `p` when it has one host only.
-    fn one_part(&self, p: P3, part: &[u32]) -> (Option<u32>, Option<u32>) {
+    /// [`Locator::owner`], with the tet worth trying first next time (the
+    /// host of `p` when it has one host only) and whether that tet holds
+    /// `p` strictly.
+    fn one_part(&self, p: P3, part: &[u32]) -> (Option<u32>, Option<u32>, bool) {
         // A tet that holds `p` strictly is its only host (the common case);
         // else every host must be in one part.
         let mut own: Option<u32> = None;
@@ -406,9 +453,9 @@ impl<'a> Locator<'a> {
             }
         });
         match strict {
-            Some(t) => (Some(part[t as usize]), Some(t)),
-            None if mixed => (None, None),
-            None => (own, (hosts == 1).then_some(first)),
+            Some(t) => (Some(part[t as usize]), Some(t), true),
+            None if mixed => (None, None, false),
+            None => (own, (hosts == 1).then_some(first), false),
         }
     }
 
@@ -524,12 +571,34 @@ impl<'a> PartFilter<'a> {
     }
 }
 
+/// Tets a walk from a nearby point's tet visits before the bins decide.
+const WALK_STEPS: usize = 4;
+
 impl RegionFilter for PartFilter<'_> {
     fn point_ok(&self, p: P3) -> bool {
         self.loc.owner_near(p, self.part, &self.hint) == Some(self.k)
     }
     fn edge_ok(&self, a: P3, b: P3) -> bool {
         !self.walls.crosses(self.k, a, b)
+    }
+    /// The place is the DDG tet that holds `p` strictly. `near` is tried
+    /// first, then the last tet found, then the bins.
+    fn locate(&self, p: P3, near: &[u32]) -> (bool, u32) {
+        for (i, &t) in near.iter().enumerate() {
+            if near[..i].contains(&t) {
+                continue;
+            }
+            if let Some(t) = self.loc.walk(t, p, WALK_STEPS) {
+                return (self.part[t as usize] == self.k, t);
+            }
+        }
+        let (own, strict) = self.loc.owner_placed(p, self.part, &self.hint);
+        (own == Some(self.k), strict.unwrap_or(NO_PLACE))
+    }
+    /// Two ends strictly inside one DDG tet: the segment is inside it
+    /// (convex), so it meets no wall.
+    fn edge_ok_at(&self, a: P3, ta: u32, b: P3, tb: u32) -> bool {
+        (ta == tb && ta != NO_PLACE) || self.edge_ok(a, b)
     }
 }
 
@@ -625,6 +694,52 @@ mod tests {
             inside > 100 && outside > 100 && shared > 100,
             "{inside} {outside} {shared}"
         );
+    }
+
+    /// The part filter's `locate`, from any hints, answers as `point_ok`,
+    /// and the place it gives holds the point strictly; a walk ends only at
+    /// such a tet; `edge_ok_at` answers as `edge_ok`.
+    #[test]
+    fn hinted_location_answers_as_the_bins() {
+        let d = torus_ddg();
+        let loc = Locator::new(&d);
+        let part: Vec<u32> = (0..d.tets.len() as u32).map(|t| (t / 7) % 5).collect();
+        let walls = Interfaces::new(&d, &part);
+        let f = PartFilter::new(&loc, &walls, &part, 2);
+        let probes = probes(&d);
+        let n = d.tets.len() as u32;
+        let (mut walked, mut placed) = (0, 0);
+        let mut at = Vec::new();
+        for (i, &p) in probes.iter().enumerate() {
+            // Hints: the host of the previous probe, a tet far off, none.
+            let near = [
+                at.last().copied().unwrap_or(NO_PLACE),
+                (i as u32 * 7919) % n,
+                NO_PLACE,
+            ];
+            let (ok, t) = f.locate(p, &near);
+            assert_eq!(ok, f.point_ok(p), "locate {p:?}");
+            if t != NO_PLACE {
+                assert!(loc.strictly_holds(t, p), "place of {p:?}");
+                placed += 1;
+            }
+            for &h in &near[..2] {
+                if let Some(w) = loc.walk(h, p, WALK_STEPS) {
+                    assert!(loc.strictly_holds(w, p), "walk to {p:?}");
+                    walked += 1;
+                }
+            }
+            at.push(t);
+        }
+        assert!(walked > 100 && placed > 1000, "{walked} {placed}");
+        for i in 1..probes.len() {
+            let (a, b) = (probes[i - 1], probes[i]);
+            assert_eq!(f.edge_ok_at(a, at[i - 1], b, at[i]), f.edge_ok(a, b));
+            // The short edge inside the place of `a`.
+            let c = [0, 1, 2].map(|k| 0.9 * a[k] + 0.1 * b[k]);
+            let tc = f.locate(c, &[at[i - 1]]).1;
+            assert_eq!(f.edge_ok_at(a, at[i - 1], c, tc), f.edge_ok(a, c));
+        }
     }
 
     #[test]

@@ -73,7 +73,22 @@ pub trait RegionFilter: Sync {
     fn edge_ok(&self, _a: P3, _b: P3) -> bool {
         true
     }
+    /// [`RegionFilter::point_ok`], and a place that holds `p` alone (a
+    /// cell of the filter's own, [`NO_PLACE`] when it has none): a later
+    /// query near `p` tries it first (`near`, places of nearby points), and
+    /// [`RegionFilter::edge_ok_at`] decides by it. The answer does not
+    /// depend on `near`.
+    fn locate(&self, p: P3, _near: &[u32]) -> (bool, u32) {
+        (self.point_ok(p), NO_PLACE)
+    }
+    /// [`RegionFilter::edge_ok`] for ends located at places `pa` and `pb`.
+    fn edge_ok_at(&self, a: P3, _pa: u32, b: P3, _pb: u32) -> bool {
+        self.edge_ok(a, b)
+    }
 }
+
+/// No place known ([`RegionFilter::locate`]).
+pub const NO_PLACE: u32 = u32::MAX;
 
 /// No restriction: the serial mesher.
 pub struct Everywhere;

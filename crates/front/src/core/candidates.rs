@@ -17,14 +17,14 @@ impl<'a> Front<'a> {
     pub(super) fn point_in(&mut self, i: u32) -> bool {
         let i = i as usize;
         if i >= self.point_in.len() {
-            self.point_in.resize(self.pts.len().max(i + 1), 0);
+            let n = self.pts.len().max(i + 1);
+            self.point_in.resize(n, 0);
+            self.point_at.resize(n, NO_PLACE);
         }
         if self.point_in[i] == 0 {
-            self.point_in[i] = if self.region.point_ok(self.pts[i]) {
-                1
-            } else {
-                2
-            };
+            let (ok, at) = self.region.locate(self.pts[i], &[]);
+            self.point_in[i] = if ok { 1 } else { 2 };
+            self.point_at[i] = at;
         }
         self.point_in[i] == 1
     }
@@ -81,7 +81,9 @@ impl<'a> Front<'a> {
             return false;
         }
         let [pa, pb, pc] = v.map(|i| self.pts[i as usize]);
-        self.region.edge_ok(pa, pb) && self.region.edge_ok(pb, pc) && self.region.edge_ok(pc, pa)
+        let [ta, tb, tc] = v.map(|i| self.point_at[i as usize]);
+        let r = self.region;
+        r.edge_ok_at(pa, ta, pb, tb) && r.edge_ok_at(pb, tb, pc, tc) && r.edge_ok_at(pc, tc, pa, ta)
     }
 
     /// AF2.1: the ideal new point over face `v`, at a regular tet's height;
@@ -101,7 +103,11 @@ impl<'a> Front<'a> {
         let dm = (dist(m, pa) + dist(m, pb) + dist(m, pc)) / 3.0;
         let alpha = (h * h - dm * dm).max(0.25 * dm * dm).sqrt();
         let pstar = add(m, scale(nrm, alpha));
-        if !self.region.point_ok(pstar) {
+        // Tried first: where the face's corners are (the region filter
+        // asked about them already), mostly the same place.
+        let near = v.map(|i| self.point_at.get(i as usize).copied().unwrap_or(NO_PLACE));
+        let (ok, at) = self.region.locate(pstar, &near);
+        if !ok {
             return None;
         }
         Some(FaceGoal {
@@ -112,6 +118,7 @@ impl<'a> Front<'a> {
             h,
             alpha,
             pstar,
+            at,
         })
     }
 
@@ -168,6 +175,11 @@ impl<'a> Front<'a> {
             }
             // A mean ratio over the floor is a volume far above rounding:
             // the float sign is the exact one, no predicate needed here.
+            // Points behind the face (about half) skip the mean ratio's
+            // cube root.
+            if tet_volume6(pa, pb, pc, pq) <= 0.0 {
+                continue;
+            }
             let (shape, mut score) = candidate_score(pa, pb, pc, pq, g.h);
             if shape <= SHAPE_FLOOR {
                 continue;
@@ -187,7 +199,17 @@ impl<'a> Front<'a> {
                     .iter()
                     .all(|&q| v.contains(&q) || dist2(self.pts[q as usize], p) >= lim * lim)
             };
-            if clear && self.region.point_ok(p) {
+            if k == 0 {
+                self.new_at.clear();
+            }
+            let ok = clear && {
+                let (ok, at) = self.region.locate(p, &[g.at]);
+                if ok {
+                    self.new_at.push((p, at));
+                }
+                ok
+            };
+            if ok {
                 let (shape, score) = candidate_score(pa, pb, pc, p, g.h);
                 if shape > SHAPE_FLOOR {
                     cands.push((score * (1.0 - 0.1 * k as f64), policy::new_point_id(k)));
@@ -291,6 +313,8 @@ struct FaceGoal {
     /// The ideal point's height, and the point.
     alpha: f64,
     pstar: P3,
+    /// Where the region filter located `pstar`.
+    at: u32,
 }
 
 impl FaceGoal {

@@ -5,7 +5,7 @@
 use crate::grid::LooseGrid;
 use crate::quality::candidate_score;
 use crate::queue::MinQueue;
-use crate::{RegionFilter, SizeMode};
+use crate::{RegionFilter, SizeMode, NO_PLACE};
 use parafront_geom::intersect::{shared_first, triangles_intersect};
 use parafront_geom::*;
 use parafront_mesh::TET_FACES;
@@ -351,6 +351,12 @@ struct Front<'a> {
     prohibited: Vec<u32>,
     /// Per point: 0 not asked yet, 1 inside the region, 2 outside.
     point_in: Vec<u8>,
+    /// Per point asked: where the region filter located it
+    /// ([`RegionFilter::locate`]), for queries near it.
+    point_at: Vec<u32>,
+    /// This try's new-point candidates that the region filter located, and
+    /// where: the one committed keeps its place.
+    new_at: Vec<(P3, u32)>,
     relax: u32,
     opts: &'a FrontOptions,
     region: &'a dyn RegionFilter,
@@ -489,6 +495,8 @@ impl<'a> Front<'a> {
             stuck: Vec::new(),
             prohibited: Vec::new(),
             point_in: Vec::new(),
+            point_at: Vec::new(),
+            new_at: Vec::new(),
             relax: 0,
             opts,
             region,
