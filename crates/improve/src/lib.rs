@@ -241,6 +241,8 @@ const LIFT_SWAP_DEG: f64 = 20.0;
 const TAN_LIFT: f64 = 0.363_970_234_266_202_34;
 /// The worst tets (at most) that get a swap or a point to lift them.
 const LIFT_WORST: usize = 64;
+/// Passes of that lift, while one lifts any.
+const LIFT_PASSES: usize = 3;
 /// Mean ratio under which the final polish after a parallel run works.
 const POLISH: f64 = 0.5;
 
