@@ -2,7 +2,7 @@
 use crate::Ddg;
 use parafront_front::{RegionFilter, NO_PLACE};
 use parafront_geom::intersect::{segment_triangle, SegTri};
-use parafront_geom::{orient3d, Aabb, P3};
+use parafront_geom::{cross, dot, orient3d, sub, Aabb, P3};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU32, Ordering};
 
@@ -212,12 +212,7 @@ impl Faces {
         let scale = Aabb::from_points(q.iter()).diagonal() + diag;
         Faces([0, 1, 2, 3].map(|f| {
             let [a, c, e] = [1, 2, 3].map(|i| q[(f + i) % 4]);
-            let (u, v) = (sub(c, a), sub(e, a));
-            let mut n = [
-                u[1] * v[2] - u[2] * v[1],
-                u[2] * v[0] - u[0] * v[2],
-                u[0] * v[1] - u[1] * v[0],
-            ];
+            let mut n = cross(sub(c, a), sub(e, a));
             // Towards the opposite corner: inside.
             if dot(n, sub(q[f], a)) < 0.0 {
                 n = n.map(|x| -x);
@@ -235,14 +230,6 @@ impl Faces {
             dot(n, sub(far, a)) < -margin
         })
     }
-}
-
-fn sub(a: P3, c: P3) -> P3 {
-    [a[0] - c[0], a[1] - c[1], a[2] - c[2]]
-}
-
-fn dot(a: P3, c: P3) -> f64 {
-    a[0] * c[0] + a[1] * c[1] + a[2] * c[2]
 }
 
 /// Whether the closed tet `q` holds `p`: `Some(true)` strictly inside (then

@@ -16,17 +16,23 @@ impl<'a> Front<'a> {
     /// move, and a pass's filter is a point location in the DDG.
     pub(super) fn point_in(&mut self, i: u32) -> bool {
         let i = i as usize;
-        if i >= self.point_in.len() {
-            let n = self.pts.len().max(i + 1);
-            self.point_in.resize(n, 0);
-            self.point_at.resize(n, NO_PLACE);
-        }
+        self.grow_point_cache(i + 1);
         if self.point_in[i] == 0 {
             let (ok, at) = self.region.locate(self.pts[i], &[]);
             self.point_in[i] = if ok { 1 } else { 2 };
             self.point_at[i] = at;
         }
         self.point_in[i] == 1
+    }
+
+    /// `point_in` and `point_at` cover points `0..n` and every point so
+    /// far.
+    pub(super) fn grow_point_cache(&mut self, n: usize) {
+        if n > self.point_in.len() {
+            let n = self.pts.len().max(n);
+            self.point_in.resize(n, 0);
+            self.point_at.resize(n, NO_PLACE);
+        }
     }
 
     pub(super) fn try_face(&mut self, fid: u32) -> Outcome {

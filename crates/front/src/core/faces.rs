@@ -90,9 +90,7 @@ impl<'a> Front<'a> {
             self.stats.new_points += 1;
             // The region filter located it as a candidate: inside.
             if let Some(&(_, at)) = self.new_at.iter().find(|x| x.0 == pq) {
-                let n = self.pts.len();
-                self.point_in.resize(n, 0);
-                self.point_at.resize(n, NO_PLACE);
+                self.grow_point_cache(id as usize + 1);
                 self.point_in[id as usize] = 1;
                 self.point_at[id as usize] = at;
             }
