@@ -47,6 +47,12 @@ pub struct FillOptions {
     /// missing: the tray's slab that it closes had 18, and the thin slot's
     /// slabs at size 0.1, where it failed at 0.3-0.6 s each, 37-69.
     pub max_conform_missing: usize,
+    /// Go straight to the conforming fill, its edges split first until
+    /// each piece is an edge of the Delaunay triangulation (no flips,
+    /// which cost seconds on a cavity of thousands of faces), with
+    /// `max_split` points at most: for a front that stalls on most of its
+    /// faces at once. Off by default.
+    pub segments_first: bool,
 }
 
 impl Default for FillOptions {
@@ -61,6 +67,7 @@ impl Default for FillOptions {
             max_search_faces: 400,
             max_split: 4096,
             max_conform_missing: 32,
+            segments_first: false,
         }
     }
 }
@@ -146,6 +153,12 @@ pub fn fill_cavity(
     local.sort_unstable();
     local.dedup();
     let mut flips = 0;
+    if opts.segments_first {
+        return conform(points, faces, &local, opts).ok_or(FillError::Unrecovered {
+            missing: faces.len(),
+            faces: faces.len(),
+        });
+    }
     // The Delaunay triangulation of its points, faces recovered by flips.
     let mut missing = match delaunay_fill(points, faces, &local, opts, false, &mut flips)? {
         Ok(f) => return Ok(f),
@@ -418,13 +431,15 @@ fn output(
 fn conform(points: &[P3], faces: &[[u32; 3]], local: &[u32], opts: &FillOptions) -> Option<Fill> {
     // Large cavities are grown by the caller instead: a failing
     // conforming fill of the tray's 1,426-face slab took 7 s.
-    if opts.max_split == 0 || faces.len() > opts.max_steiner_faces {
+    if opts.max_split == 0 || (faces.len() > opts.max_steiner_faces && !opts.segments_first) {
         return None;
     }
     // A point per face and a few more: the fills that converge on the
     // corpus use fewer (the tray's 158-face slab: 27).
     let max_split = opts.max_split.min(16 + faces.len());
-    let fill = |lp: &[P3], lf: &[[u32; 3]]| conform_fill(lp, lf, max_split, opts.flips_per_face);
+    let fill = |lp: &[P3], lf: &[[u32; 3]]| {
+        conform_fill(lp, lf, max_split, opts.flips_per_face, opts.segments_first)
+    };
     let (steiner, tets) = in_local_ids(points, faces, local, fill)?;
     Some(Fill {
         steiner,

@@ -18,7 +18,11 @@
 //! Steiner points strictly inside the cavity at its dead ends), then the
 //! conforming fill (the missing edges split in the triangulation, the
 //! split points then moved off the surface into the cavity, after Si and
-//! Gärtner), then Steiner points in the triangulation.
+//! Gärtner), then Steiner points in the triangulation. A front that
+//! stalls on its whole input asks for the conforming fill alone, its
+//! edges split first until each piece is a Delaunay edge
+//! (`FillOptions::segments_first`): flips on thousands of faces cost
+//! seconds, and a surface of needles needs less than a point per face.
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 mod check;

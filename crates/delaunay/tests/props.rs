@@ -343,3 +343,29 @@ fn fills_a_squat_three_layer_tower() {
     verify(&pts, &faces, &f);
     assert_eq!(f.method, FillMethod::Conform);
 }
+
+/// A rod of needle faces shaped as round.stl (70 sides, radius 2.54,
+/// length 60.96 in 7 rings: side triangles 8.7 long and 0.23 wide).
+/// Flips leave hundreds of its faces missing, every one for want of an
+/// edge. With its edges split first until each piece is a Delaunay edge,
+/// the conforming fill closes it and moves every split point inside.
+#[test]
+fn fills_a_needle_rod_with_its_edges_split_first() {
+    let s = parafront_surface::hard::rod(70, 2.54, 60.96, 7).flipped();
+    let (pts, faces) = (s.points, s.tris);
+    let opts = FillOptions {
+        segments_first: true,
+        ..FillOptions::default()
+    };
+    let f = fill_cavity(&pts, &faces, &opts).expect("fill");
+    verify(&pts, &faces, &f);
+    assert_eq!(f.method, FillMethod::Conform);
+    assert!(!f.steiner.is_empty());
+    // The budget is a point per face: a cavity that needs more fails, fast.
+    let tight = FillOptions {
+        segments_first: true,
+        max_split: 8,
+        ..FillOptions::default()
+    };
+    assert!(fill_cavity(&pts, &faces, &tight).is_err());
+}

@@ -563,6 +563,7 @@ fn serial_region(
             progress: opts.progress.clone(),
             keep_partial: opts.debug_partial,
             fill_after: opts.fill_after,
+            fill_early: true,
             ..FrontOptions::default()
         },
     );

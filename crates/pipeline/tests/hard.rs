@@ -71,6 +71,22 @@ fn thin_rod_is_closed_by_the_fill() {
 }
 
 #[test]
+fn needle_rod_is_filled_whole_at_once() {
+    // round.stl's shape: side triangles 8.7 long and 0.23 wide under a
+    // size of their mean edge. The front stalls before it has a tet for
+    // every other face; the fill takes the whole region, with no
+    // recovery round.
+    let s = rod(70, 2.54, 60.96, 7);
+    let (m, sum) = mesh_surface(&s, &MeshOptions::default()).expect("the rod meshes");
+    m.check_against_surface(&s.tris).expect("valid");
+    let v = s.signed_volume();
+    assert!((m.volume() - v).abs() <= 1e-9 * v);
+    assert_eq!(sum.recovery_rounds, 0, "no recovery round");
+    assert_eq!(sum.cavities_filled, 1, "one fill");
+    assert!(sum.fill_tets > 0);
+}
+
+#[test]
 fn twisted_prisms() {
     // Schönhardt: a triangular prism twisted so that no tetrahedralization
     // of its six corners exists; and a twisted square prism.

@@ -12,7 +12,72 @@ impl<'a> Front<'a> {
     /// Fill every cavity of the live front; `false` when one is left after
     /// `growth` growth rounds.
     pub(super) fn fill_stalled(&mut self, growth: u32) -> bool {
-        let fopts = FillOptions::default();
+        self.fill_with(growth, &FillOptions::default())
+    }
+
+    /// The fill of the whole input front, its edges split first (at most
+    /// one point per face: a surface of needles closes with fewer, one
+    /// whose split points would crowd each other fails fast). On success
+    /// every tet the front made gives way to it; `false` leaves the front
+    /// as it was.
+    pub(super) fn fill_early(&mut self) -> bool {
+        let faces = std::mem::take(&mut self.input0);
+        let fopts = FillOptions {
+            segments_first: true,
+            ..FillOptions::default()
+        };
+        tracing::debug!(
+            faces = faces.len(),
+            "front stalled at once: constrained fill of the region"
+        );
+        let fill = match fill_cavity(&self.pts, &faces, &fopts) {
+            Ok(f) => f,
+            Err(e) => {
+                tracing::debug!(error = %e, "region not filled");
+                return false;
+            }
+        };
+        // Exactly positive is valid; a tet flat in floating point (a split
+        // point moved a hair off the surface) would be the improvement's to
+        // undo, and the front's tets serve better.
+        let n = self.pts.len();
+        let at = |v: u32| {
+            let v = v as usize;
+            if v < n {
+                self.pts[v]
+            } else {
+                fill.steiner[v - n]
+            }
+        };
+        if fill.tets.iter().any(|t| {
+            let p = t.map(at);
+            !(tet_volume6(p[0], p[1], p[2], p[3]) > 0.0)
+        }) {
+            tracing::debug!("region fill has a tet flat in floating point");
+            return false;
+        }
+        if let Some(p) = &self.opts.progress {
+            p.note_fill();
+        }
+        let live: Vec<u32> = (0..self.tets.len() as u32)
+            .filter(|&t| self.talive[t as usize])
+            .collect();
+        for &t in &live {
+            self.talive[t as usize] = false;
+        }
+        for &t in &live {
+            self.unlink_tet(t);
+        }
+        self.stats.tets_removed += live.len();
+        let n0 = self.pts.len() as u32;
+        self.apply_fill(&faces, fill, n0);
+        self.stuck.clear();
+        self.heap.clear();
+        self.prohibited.clear();
+        true
+    }
+
+    fn fill_with(&mut self, growth: u32, fopts: &FillOptions) -> bool {
         for round in 0..=growth {
             let comps = self.live_components();
             if comps.is_empty() {
@@ -34,7 +99,7 @@ impl<'a> Front<'a> {
             let n0 = pts.len() as u32;
             let fills: Vec<_> = cavities
                 .par_iter()
-                .map(|faces| fill_cavity(pts, faces, &fopts))
+                .map(|faces| fill_cavity(pts, faces, fopts))
                 .collect();
             let mut failed: Vec<u32> = Vec::new();
             let mut closed = 0;
