@@ -147,6 +147,22 @@ fn tiny_feature_under_a_given_size() {
 }
 
 proptest! {
+    #![proptest_config(ProptestConfig::with_cases(8))]
+    /// Rods of needle faces, thin or stout: whether the front stalls at
+    /// once (and the fill takes the region) or not, each meshes with
+    /// default options, and the mesh keeps the surface and its volume.
+    #[test]
+    fn needle_rods(
+        k in 24usize..90,
+        r in 0.3f64..4.0,
+        len in 20.0f64..80.0,
+        segs in 3usize..10,
+    ) {
+        meshes_at("needle rod", &rod(k, r, len, segs), &[None]);
+    }
+}
+
+proptest! {
     #![proptest_config(ProptestConfig::with_cases(12))]
     /// Towers of twisted layers (no layer has a tetrahedralization of its
     /// own corners), squat or tall: each meshes with default options.
