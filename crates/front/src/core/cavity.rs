@@ -200,13 +200,7 @@ impl<'a> Front<'a> {
             }
 
             let before = self.fv.len();
-            for &t in &dead {
-                self.talive[t as usize] = false;
-            }
-            for &t in &dead {
-                self.unlink_tet(t);
-            }
-            self.stats.tets_removed += dead.len();
+            self.remove_tets(&dead);
             match self.first_alive(&pocket, before as u32) {
                 Some(f) => seed = f,
                 None => return Pocket::Failed,

@@ -32,6 +32,19 @@ impl<'a> Front<'a> {
         self.fgrid.remove(id, &tri_box(&self.pts, v));
     }
 
+    /// Remove live tets `ts` (recovery, a fill's growth or takeover): all
+    /// are marked dead before any is unlinked, so that the faces between
+    /// two of them do not join the front.
+    pub(super) fn remove_tets(&mut self, ts: &[u32]) {
+        for &t in ts {
+            self.talive[t as usize] = false;
+        }
+        for &t in ts {
+            self.unlink_tet(t);
+        }
+        self.stats.tets_removed += ts.len();
+    }
+
     /// Take dead tet `t` out: its faces towards live tets or the input
     /// surface join the front, its front faces leave it.
     pub(super) fn unlink_tet(&mut self, t: u32) {

@@ -12,7 +12,70 @@ impl<'a> Front<'a> {
     /// Fill every cavity of the live front; `false` when one is left after
     /// `growth` growth rounds.
     pub(super) fn fill_stalled(&mut self, growth: u32) -> bool {
-        self.fill_with(growth, &FillOptions::default())
+        let fopts = FillOptions::default();
+        for round in 0..=growth {
+            let comps = self.live_components();
+            if comps.is_empty() {
+                return true;
+            }
+            tracing::debug!(
+                round,
+                cavities = comps.len(),
+                "front stalled: constrained fill"
+            );
+            if let Some(p) = &self.opts.progress {
+                p.note_fill();
+            }
+            let cavities: Vec<Vec<[u32; 3]>> = comps
+                .iter()
+                .map(|c| c.iter().map(|&f| self.fv[f as usize].v).collect())
+                .collect();
+            let pts = &self.pts;
+            let n0 = pts.len() as u32;
+            let fills: Vec<_> = cavities
+                .par_iter()
+                .map(|faces| fill_cavity(pts, faces, &fopts))
+                .collect();
+            let mut failed: Vec<u32> = Vec::new();
+            let mut closed = 0;
+            for ((ids, faces), fill) in comps.iter().zip(&cavities).zip(fills) {
+                match fill {
+                    Ok(fill) => {
+                        closed += 1;
+                        self.apply_fill(faces, fill, n0)
+                    }
+                    Err(e) => {
+                        tracing::debug!(faces = faces.len(), error = %e, "cavity not filled");
+                        failed.extend_from_slice(ids);
+                    }
+                }
+            }
+            if failed.is_empty() {
+                return true;
+            }
+            // A growth round that closed nothing is not followed by more.
+            if round == growth || (round > 0 && closed == 0) {
+                break;
+            }
+            // Grow each cavity left by the tets behind its faces.
+            let mut grow: Vec<u32> = failed
+                .iter()
+                .filter(|&&f| self.fv[f as usize].alive)
+                .map(|&f| self.fv[f as usize].owner)
+                .filter(|&o| o != NONE)
+                .map(|o| o >> 2)
+                .collect();
+            grow.sort_unstable();
+            grow.dedup();
+            if grow.is_empty() {
+                break;
+            }
+            self.remove_tets(&grow);
+        }
+        self.stuck = (0..self.fv.len() as u32)
+            .filter(|&f| self.fv[f as usize].alive)
+            .collect();
+        false
     }
 
     /// The fill of the whole input front, its edges split first (at most
@@ -62,91 +125,12 @@ impl<'a> Front<'a> {
         let live: Vec<u32> = (0..self.tets.len() as u32)
             .filter(|&t| self.talive[t as usize])
             .collect();
-        for &t in &live {
-            self.talive[t as usize] = false;
-        }
-        for &t in &live {
-            self.unlink_tet(t);
-        }
-        self.stats.tets_removed += live.len();
-        let n0 = self.pts.len() as u32;
-        self.apply_fill(&faces, fill, n0);
+        self.remove_tets(&live);
+        self.apply_fill(&faces, fill, n as u32);
         self.stuck.clear();
         self.heap.clear();
         self.prohibited.clear();
         true
-    }
-
-    fn fill_with(&mut self, growth: u32, fopts: &FillOptions) -> bool {
-        for round in 0..=growth {
-            let comps = self.live_components();
-            if comps.is_empty() {
-                return true;
-            }
-            tracing::debug!(
-                round,
-                cavities = comps.len(),
-                "front stalled: constrained fill"
-            );
-            if let Some(p) = &self.opts.progress {
-                p.note_fill();
-            }
-            let cavities: Vec<Vec<[u32; 3]>> = comps
-                .iter()
-                .map(|c| c.iter().map(|&f| self.fv[f as usize].v).collect())
-                .collect();
-            let pts = &self.pts;
-            let n0 = pts.len() as u32;
-            let fills: Vec<_> = cavities
-                .par_iter()
-                .map(|faces| fill_cavity(pts, faces, fopts))
-                .collect();
-            let mut failed: Vec<u32> = Vec::new();
-            let mut closed = 0;
-            for ((ids, faces), fill) in comps.iter().zip(&cavities).zip(fills) {
-                match fill {
-                    Ok(fill) => {
-                        closed += 1;
-                        self.apply_fill(faces, fill, n0)
-                    }
-                    Err(e) => {
-                        tracing::debug!(faces = faces.len(), error = %e, "cavity not filled");
-                        failed.extend_from_slice(ids);
-                    }
-                }
-            }
-            if failed.is_empty() {
-                return true;
-            }
-            // A growth round that closed nothing is not followed by more.
-            if round == growth || (round > 0 && closed == 0) {
-                break;
-            }
-            // Grow each cavity left by the tets behind its faces.
-            let mut grow: Vec<u32> = failed
-                .iter()
-                .filter(|&&f| self.fv[f as usize].alive)
-                .map(|&f| self.fv[f as usize].owner)
-                .filter(|&o| o != NONE)
-                .map(|o| o >> 2)
-                .collect();
-            grow.sort_unstable();
-            grow.dedup();
-            if grow.is_empty() {
-                break;
-            }
-            for &t in &grow {
-                self.talive[t as usize] = false;
-            }
-            for &t in &grow {
-                self.unlink_tet(t);
-            }
-            self.stats.tets_removed += grow.len();
-        }
-        self.stuck = (0..self.fv.len() as u32)
-            .filter(|&f| self.fv[f as usize].alive)
-            .collect();
-        false
     }
 
     /// The live faces in components joined by shared edges, each sorted,

@@ -633,8 +633,8 @@ impl<'a> Front<'a> {
                         if self.pts.len() > self.opts.max_points {
                             return Err(FrontError::TooManyPoints(self.opts.max_points));
                         }
-                        if self.stats.tets as f64 > EARLY_FILL_TETS * self.input0.len() as f64
-                            && !self.input0.is_empty()
+                        if !self.input0.is_empty()
+                            && self.stats.tets as f64 > EARLY_FILL_TETS * self.input0.len() as f64
                         {
                             self.input0 = Vec::new();
                         }

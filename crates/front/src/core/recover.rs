@@ -54,13 +54,7 @@ impl<'a> Front<'a> {
                 self.talive[t as usize] && tv.iter().filter(|&&p| mark[p as usize]).count() >= need
             })
             .collect();
-        for &t in &removed {
-            self.talive[t as usize] = false;
-        }
-        for &t in &removed {
-            self.unlink_tet(t);
-        }
-        self.stats.tets_removed += removed.len();
+        self.remove_tets(&removed);
         self.requeue_front();
     }
 
