@@ -488,6 +488,30 @@ impl<'a> Front<'a> {
         w
     }
 
+    /// Whether the worst cone over `p` beats `floor`: faces from `*first`
+    /// on, wrapping, and `*first` left at the one that failed. The face
+    /// that failed one candidate usually fails the next, so a losing
+    /// candidate costs a face or two instead of the whole pocket; the
+    /// answer is [`Front::worst_cone`]`(pocket, p) > floor` exactly.
+    fn cone_beats(&self, pocket: &[u32], p: P3, floor: f64, first: &mut usize) -> Option<f64> {
+        let n = pocket.len();
+        let mut w = f64::INFINITY;
+        for k in 0..n {
+            let i = (*first + k) % n;
+            w = w.min(self.cone_shape(pocket[i], p));
+            if w <= floor {
+                *first = i;
+                return None;
+            }
+            if w < -1.0 {
+                // `worst_cone` stops here, in its own order.
+                let w = self.worst_cone(pocket, p);
+                return (w > floor).then_some(w);
+            }
+        }
+        Some(w)
+    }
+
     /// A point that sees every pocket face as well as it can: the best of
     /// a few inward offsets and the vertex centroid, then a pattern search.
     fn kernel_point(&self, pocket: &[u32]) -> P3 {
@@ -525,9 +549,9 @@ impl<'a> Front<'a> {
         }
         let mut best = c;
         let mut bw = f64::NEG_INFINITY;
+        let mut first = 0;
         for q in cands {
-            let w = self.worst_cone(pocket, q);
-            if w > bw {
+            if let Some(w) = self.cone_beats(pocket, q, bw, &mut first) {
                 bw = w;
                 best = q;
             }
@@ -539,8 +563,7 @@ impl<'a> Front<'a> {
             for k in 0..6 {
                 let mut q = best;
                 q[k / 2] += if k % 2 == 0 { step } else { -step };
-                let w = self.worst_cone(pocket, q);
-                if w > bw {
+                if let Some(w) = self.cone_beats(pocket, q, bw, &mut first) {
                     bw = w;
                     best = q;
                     moved = true;
