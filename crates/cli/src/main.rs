@@ -791,7 +791,7 @@ fn print_summary(sum: &Summary) {
     }
     if !sum.regions_filled.is_empty() {
         println!(
-            "warning: the front could not close region{} {:?}: filled whole by the constrained fill of its surface (valid, but its tets follow the surface, not the size field)",
+            "warning: the front could not close region{} {:?}: filled whole by the constrained Delaunay fill of its surface, refined to the size field (GDT: valid, but not the front's quality)",
             if sum.regions_filled.len() == 1 { "" } else { "s" },
             sum.regions_filled
         );

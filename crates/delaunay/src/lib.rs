@@ -23,6 +23,10 @@
 //! edges split first until each piece is a Delaunay edge
 //! (`FillOptions::segments_first`): flips on thousands of faces cost
 //! seconds, and a surface of needles needs less than a point per face.
+//!
+//! [`refine_to_size`] is GDT's next step: it refines a filled region to a
+//! size field by Bowyer-Watson insertion of seeds (a lattice) and of
+//! circumcentres, never across the region's boundary.
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 mod check;
@@ -31,10 +35,12 @@ mod fill;
 mod flips;
 mod predicates;
 mod recover;
+mod refine;
 mod search;
 mod tri;
 
 pub use check::CheckError;
 pub use fill::{fill_cavity, Fill, FillError, FillMethod, FillOptions};
 pub use flips::Flip;
+pub use refine::{refine_to_size, RefineError, RefineOptions, Refined};
 pub use tri::{InsertError, Triangulation, NONE, TET_FACES};

@@ -37,13 +37,13 @@ pub struct Triangulation {
     pub(crate) tets: Vec<[u32; 4]>,
     pub(crate) neigh: Vec<u32>,
     pub(crate) alive: Vec<bool>,
-    free: Vec<u32>,
+    pub(crate) free: Vec<u32>,
     /// A live tet on each point (a hint, refreshed on use).
     pub(crate) vtet: Vec<u32>,
-    last: u32,
+    pub(crate) last: u32,
     // Scratch for insertion.
     conflict: Vec<u32>,
-    mark: Vec<u32>,
+    pub(crate) mark: Vec<u32>,
     epoch: u32,
 }
 
@@ -60,7 +60,7 @@ impl Triangulation {
 
     /// Only the bounding tet of `points`, with the points stored (ids
     /// `4..`) but not inserted yet.
-    fn bounding(points: &[P3]) -> Result<Triangulation, InsertError> {
+    pub(crate) fn bounding(points: &[P3]) -> Result<Triangulation, InsertError> {
         if let Some(p) = points.iter().find(|p| !p.iter().all(|x| x.is_finite())) {
             return Err(InsertError::NotFinite(*p));
         }
@@ -218,7 +218,7 @@ impl Triangulation {
             .all(|fv| orient3d(tp[fv[0]], tp[fv[1]], tp[fv[2]], p) <= 0.0)
     }
 
-    fn new_epoch(&mut self) -> u32 {
+    pub(crate) fn new_epoch(&mut self) -> u32 {
         self.epoch = self.epoch.wrapping_add(1);
         if self.epoch == 0 {
             self.mark.iter_mut().for_each(|m| *m = 0);

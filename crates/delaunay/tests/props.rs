@@ -1,6 +1,9 @@
 //! Property tests: the kernel on random and degenerate point sets, the fill
 //! on star-shaped, convex, twisted and slotted cavities.
-use parafront_delaunay::{fill_cavity, Fill, FillMethod, FillOptions, Triangulation, TET_FACES};
+use parafront_delaunay::{
+    fill_cavity, refine_to_size, Fill, FillMethod, FillOptions, RefineOptions, Triangulation,
+    TET_FACES,
+};
 use parafront_geom::{orient3d, P3};
 use proptest::prelude::*;
 use std::collections::HashMap;
@@ -368,4 +371,64 @@ fn fills_a_needle_rod_with_its_edges_split_first() {
         ..FillOptions::default()
     };
     assert!(fill_cavity(&pts, &faces, &tight).is_err());
+}
+
+/// The fill refined to a size (GDT's start): still valid with the cavity's
+/// faces kept, every point used, and the new points where the size asks.
+fn refined(pts: &[P3], faces: &[[u32; 3]], h: f64) -> Fill {
+    let f = fill_cavity(pts, faces, &FillOptions::default()).expect("fill");
+    let mut all = pts.to_vec();
+    all.extend_from_slice(&f.steiner);
+    let r = refine_to_size(&all, &f.tets, &[], &|_| h, &RefineOptions::default()).expect("refine");
+    assert!(!r.capped);
+    // About one point per h^3 of volume: at least a fifth of that.
+    let vol: f64 = f
+        .tets
+        .iter()
+        .map(|t| {
+            let p = t.map(|v| all[v as usize]);
+            orient3d(p[0], p[1], p[2], p[3]) / 6.0
+        })
+        .sum();
+    let want = vol / (h * h * h);
+    assert!(
+        r.points.len() as f64 >= 0.2 * want - 1.0,
+        "{} new points for {want:.0}",
+        r.points.len()
+    );
+    let mut steiner = f.steiner.clone();
+    steiner.extend_from_slice(&r.points);
+    let out = Fill {
+        steiner,
+        tets: r.tets,
+        ..f
+    };
+    verify(pts, faces, &out);
+    let mut used = vec![false; pts.len() + out.steiner.len()];
+    out.tets
+        .iter()
+        .flatten()
+        .for_each(|&v| used[v as usize] = true);
+    assert!(used.iter().all(|&u| u), "a point left out");
+    out
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(16))]
+    /// Twisted towers (fills with Steiner points and recovery flips, so
+    /// not Delaunay) and slotted boxes, refined to sizes from a tenth of
+    /// the part to a thirtieth.
+    #[test]
+    fn refines_fills_of_twisted_towers_and_slots(
+        twists in prop::collection::vec(0.2f64..0.9, 1..5),
+        height in prop::sample::select(vec![0.3, 1.0, 5.0]),
+        gap in prop::sample::select(vec![0.2, 1e-2, 1e-3]),
+        k in 10.0f64..30.0,
+    ) {
+        let (pts, faces) = twisted_tower(&twists, height);
+        let span = height * twists.len() as f64;
+        refined(&pts, &faces, span.max(2.0) / k);
+        let (pts, faces) = slotted_box(gap);
+        refined(&pts, &faces, 1.0 / k);
+    }
 }

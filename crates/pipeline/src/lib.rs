@@ -571,7 +571,8 @@ fn serial_region(
     let res = match res {
         Ok(r) => r,
         // The front could not close the region: the constrained fill of its
-        // whole surface (valid, coarse), unless a debug dump was asked for.
+        // whole surface, refined to the size field by Delaunay insertion
+        // (GDT, §2), unless a debug dump was asked for.
         Err(e @ FrontError::Stuck { .. }) if !opts.debug_partial => {
             // The front took the points; this path is rare, so they are
             // gathered again rather than copied on every run.
@@ -582,16 +583,35 @@ fn serial_region(
                 &parafront_delaunay::FillOptions::default(),
             )
             .map_err(|_| MeshError::Front { region, source: e })?;
-            tracing::warn!(
-                region,
-                tets = fill.tets.len(),
-                "the front could not close the region: filled whole by the constrained fill"
-            );
             let mut all = points;
             all.extend_from_slice(&fill.steiner);
-            append_region(mesh, rf, &all, &fill.tets);
+            // The fill is valid, so refinement takes it; were it not, the
+            // fill as it is still is a mesh.
+            // The region's lattice (§2), where it has one, seeds it.
+            let tets = match parafront_delaunay::refine_to_size(
+                &all,
+                &fill.tets,
+                &lattice.points,
+                &field,
+                &parafront_delaunay::RefineOptions::default(),
+            ) {
+                Ok(r) => {
+                    all.extend_from_slice(&r.points);
+                    r.tets
+                }
+                Err(err) => {
+                    tracing::warn!(region, %err, "the region's fill was not refined");
+                    fill.tets
+                }
+            };
+            tracing::warn!(
+                region,
+                tets = tets.len(),
+                "the front could not close the region: filled whole by the constrained fill"
+            );
+            append_region(mesh, rf, &all, &tets);
             sum.regions_filled.push(region);
-            sum.fill_tets += fill.tets.len();
+            sum.fill_tets += tets.len();
             return Ok(());
         }
         Err(e) => return Err(MeshError::Front { region, source: e }),

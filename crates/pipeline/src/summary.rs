@@ -113,9 +113,9 @@ pub struct Summary {
     /// See `lattice_tets`.
     pub lattice_cells: usize,
     /// Regions the front could not close at all, filled whole by the
-    /// constrained fill of their surface instead: valid, but coarse (their
-    /// tets follow the surface, not the size field). Ids as in `Front`
-    /// errors.
+    /// constrained fill of their surface instead, then refined to the size
+    /// field by Delaunay insertion: valid, without the front's quality.
+    /// Ids as in `Front` errors.
     pub regions_filled: Vec<usize>,
     /// Shells (ids as `parafront check` prints them) oriented as inner
     /// bodies and meshed as voids, without `regions`.

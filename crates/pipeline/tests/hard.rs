@@ -130,6 +130,19 @@ fn slot_under_ten_times_its_width() {
     assert_eq!(sum.regions_filled, vec![1], "the whole-region fill ran");
     let v = s.signed_volume();
     assert!((m.volume() - v).abs() <= 1e-9 * v);
+    // The fill is refined to the size (GDT): a regular tet of edge 0.1 is
+    // 1.2e-4, so about 8,000 of them; the fill alone made 23.
+    assert!(m.tets.len() > 3000, "{} tets", m.tets.len());
+    let (mut sum_l, mut n) = (0.0, 0);
+    for t in &m.tets {
+        for (a, b) in [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)] {
+            let (p, q) = (m.points[t[a].idx()], m.points[t[b].idx()]);
+            sum_l += ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2)).sqrt();
+            n += 1;
+        }
+    }
+    let mean = sum_l / n as f64;
+    assert!(mean < 0.15, "mean edge {mean}");
 }
 
 #[test]
