@@ -300,7 +300,13 @@ impl Triangulation {
     fn spaced_cavity(&mut self, id: u32, spacing: f64) -> Option<(Vec<u32>, u32)> {
         let p = self.pts[id as usize];
         let t0 = self.locate(p, self.last)?;
-        if !self.holds(t0, p) {
+        // `t0` stays in the cavity: its corners are checked at once, before
+        // the cavity is built (most rejected points fail here).
+        if !self.holds(t0, p)
+            || self.tets[t0 as usize]
+                .iter()
+                .any(|&v| dist(self.pts[v as usize], p) < spacing)
+        {
             return None;
         }
         let ep = self.new_epoch();
