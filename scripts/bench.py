@@ -61,7 +61,8 @@ SETS = {
     "hard": [(f"%{n}.obj", []) for n in ["needle_1000", "needle_5000", "schonhardt",
                                           "twisted_square", "squat_tower", "rod", "slot_1e-2",
                                           "slot_1e-3", "boss_1e-4"]]
-    + [("%slot_1e-2.obj", ["--size", "0.1"]), ("%boss_1e-4.obj", ["--size", "0.1"])],
+    + [("%slot_1e-2.obj", ["--size", "0.1"]), ("%slot_1e-3.obj", ["--size", "0.1"]),
+       ("%boss_1e-4.obj", ["--size", "0.1"])],
     "bench1e5": [(f"bench/{n}_1e5.stl", []) for n in ["sphere", "torus", "box2holes", "spheres27"]],
     "bench1e6": [(f"bench/{n}_1e6.stl", []) for n in ["sphere", "torus"]],
     # Issue 21's other measure: a uniform size under which parafront makes
