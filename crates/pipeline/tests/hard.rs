@@ -103,13 +103,13 @@ fn thin_slots() {
 
 /// Under a size 10 times the slot's width the front stalls beside the slot
 /// in thin, folded, nearly flat cavities (6V ~ 1e-4 of the slot's scale)
-/// that neither the flips nor the search close; after three failed fills the
-/// pipeline fills the whole region from its surface (valid, coarse). The
-/// 0.1 % slot at size 0.01 is a run of minutes (a million-tet front before
-/// it stalls): ignored for CI; `slot_under_ten_times_its_width` is the
-/// quick case.
+/// that neither the flips nor the search close; after a failed fill the
+/// pipeline fills the whole region from its surface and refines it to the
+/// size (GDT). The 0.1 % slot at size 0.01 is a run of minutes (a
+/// million-tet front before it stalls, then millions of refined tets):
+/// ignored for CI; `slot_under_ten_times_its_width` is the quick case.
 #[test]
-#[ignore = "minutes: a million-tet front before the region fill (run with --ignored)"]
+#[ignore = "minutes: a million-tet front, then the region fill refined to millions of tets (run with --ignored)"]
 fn thin_slots_under_a_large_size() {
     for gap in [1e-2, 1e-3] {
         meshes(&format!("slot {gap}"), &slotted_box(gap));
