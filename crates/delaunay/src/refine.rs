@@ -76,17 +76,7 @@ pub fn refine_to_size(
         if tri.pts.len() - n0 >= opts.max_points {
             break;
         }
-        let h = size(x);
-        let id = tri.pts.len() as u32;
-        tri.pts.push(x);
-        tri.vtet.push(NONE);
-        match tri.spaced_cavity(id, 0.5 * h) {
-            Some((cav, ep)) => tri.replace_by_cones(id, &cav, ep),
-            None => {
-                tri.pts.pop();
-                tri.vtet.pop();
-            }
-        }
+        tri.try_insert(x, 0.5 * size(x));
     }
     // Worklist of (slot, corners): a slot reused since is skipped.
     let mut work: Vec<(u32, [u32; 4])> = tri.live_tets().map(|t| (t, tri.tet(t))).collect();
@@ -111,20 +101,14 @@ pub fn refine_to_size(
         // The circumcentre, else (beyond the boundary: a tet on a surface
         // face) the centroid, which the boundary cannot be in the way of.
         let g = scale(add(add(tp[0], tp[1]), add(tp[2], tp[3])), 0.25);
-        for x in [c, g] {
-            let id = tri.pts.len() as u32;
-            tri.pts.push(x);
-            tri.vtet.push(NONE);
-            tri.last = t;
-            if let Some((cav, ep)) = tri.spaced_cavity(id, 0.5 * h) {
-                tri.replace_by_cones(id, &cav, ep);
-                for u in tri.star(id) {
-                    work.push((u, tri.tet(u)));
-                }
-                break;
+        tri.last = t;
+        if let Some(id) = tri
+            .try_insert(c, 0.5 * h)
+            .or_else(|| tri.try_insert(g, 0.5 * h))
+        {
+            for u in tri.star(id) {
+                work.push((u, tri.tet(u)));
             }
-            tri.pts.pop();
-            tri.vtet.pop();
         }
     }
     let new = tri.pts[n0..].to_vec();
@@ -275,28 +259,33 @@ impl Triangulation {
             cav.clear();
             cav.push(t0);
             self.mark[t0 as usize] = ep;
-            let mut i = 0;
-            while i < cav.len() {
-                let t = cav[i];
-                i += 1;
-                for f in 0..4 {
-                    let nb = self.neigh[4 * t as usize + f];
-                    if nb != NONE
-                        && self.mark[(nb >> 2) as usize] != ep
-                        && keep.contains(&(nb >> 2))
-                    {
-                        self.mark[(nb >> 2) as usize] = ep;
-                        cav.push(nb >> 2);
-                    }
-                }
+            self.grow_cavity(cav, ep, |_, u| keep.contains(&u));
+        }
+    }
+
+    /// Add point `x` and insert it where [`Triangulation::spaced_cavity`]
+    /// allows: its id; otherwise the point is dropped again.
+    fn try_insert(&mut self, x: P3, spacing: f64) -> Option<u32> {
+        let id = self.pts.len() as u32;
+        self.pts.push(x);
+        self.vtet.push(NONE);
+        match self.spaced_cavity(id, spacing) {
+            Some((cav, ep)) => {
+                self.replace_by_cones(id, &cav, ep);
+                Some(id)
+            }
+            None => {
+                self.pts.pop();
+                self.vtet.pop();
+                None
             }
         }
     }
 
     /// The Bowyer-Watson cavity of point `id` (stored, not inserted),
-    /// grown until star-shaped, and its epoch; `None` when the point lies
-    /// outside the region, the cavity would cross its boundary, or a
-    /// corner of the cavity is nearer than `spacing`.
+    /// shrunk until star-shaped, and its epoch; `None` when the point lies
+    /// outside the region or on a face of the tet that holds it, a corner
+    /// would be dropped, or one is nearer than `spacing`.
     fn spaced_cavity(&mut self, id: u32, spacing: f64) -> Option<(Vec<u32>, u32)> {
         let p = self.pts[id as usize];
         let t0 = self.locate(p, self.last)?;
@@ -309,30 +298,8 @@ impl Triangulation {
         {
             return None;
         }
-        let ep = self.new_epoch();
-        let mut cav = vec![t0];
-        self.mark[t0 as usize] = ep;
-        let mut i = 0;
-        while i < cav.len() {
-            let t = cav[i];
-            i += 1;
-            for f in 0..4 {
-                let nb = self.neigh[4 * t as usize + f];
-                if nb == NONE || self.mark[(nb >> 2) as usize] == ep {
-                    continue;
-                }
-                let u = nb >> 2;
-                if crate::predicates::in_sphere_sos(
-                    self.tets[u as usize],
-                    self.tet_points(u),
-                    id,
-                    p,
-                ) {
-                    self.mark[u as usize] = ep;
-                    cav.push(u);
-                }
-            }
-        }
+        let mut cav = Vec::new();
+        let ep = self.conflict_region(id, t0, &mut cav);
         self.shrink_to_star(p, t0, &mut cav, ep)?;
         // Every corner must stay on the cavity's boundary: in a region that
         // is not Delaunay (recovery flips, moved Steiner points) a cavity

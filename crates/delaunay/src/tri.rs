@@ -240,11 +240,36 @@ impl Triangulation {
                 return Err(InsertError::Duplicate(p, v));
             }
         }
-        let ep = self.new_epoch();
         let mut cav = std::mem::take(&mut self.conflict);
+        let ep = self.conflict_region(id, t0, &mut cav);
+        self.star_cavity(id, &mut cav, ep)?;
+        self.replace_by_cones(id, &cav, ep);
+        self.conflict = cav;
+        Ok(())
+    }
+
+    /// The tets whose perturbed circumsphere holds point `id`, grown from
+    /// `t0` (which holds it) into `cav`, marked with the epoch returned.
+    pub(crate) fn conflict_region(&mut self, id: u32, t0: u32, cav: &mut Vec<u32>) -> u32 {
+        let p = self.pts[id as usize];
+        let ep = self.new_epoch();
         cav.clear();
         cav.push(t0);
         self.mark[t0 as usize] = ep;
+        self.grow_cavity(cav, ep, |tri, u| {
+            in_sphere_sos(tri.tets[u as usize], tri.tet_points(u), id, p)
+        });
+        ep
+    }
+
+    /// Grow the cavity `cav` (its tets marked `ep`), breadth first, across
+    /// faces to every tet `accept` takes.
+    pub(crate) fn grow_cavity(
+        &mut self,
+        cav: &mut Vec<u32>,
+        ep: u32,
+        accept: impl Fn(&Triangulation, u32) -> bool,
+    ) {
         let mut i = 0;
         while i < cav.len() {
             let t = cav[i];
@@ -255,16 +280,12 @@ impl Triangulation {
                     continue;
                 }
                 let u = nb >> 2;
-                if in_sphere_sos(self.tets[u as usize], self.tet_points(u), id, p) {
+                if accept(self, u) {
                     self.mark[u as usize] = ep;
                     cav.push(u);
                 }
             }
         }
-        self.star_cavity(id, &mut cav, ep)?;
-        self.replace_by_cones(id, &cav, ep);
-        self.conflict = cav;
-        Ok(())
     }
 
     /// Grow the cavity `cav` (marked `ep`) until point `id` sees every face

@@ -670,9 +670,8 @@ impl<'a> Front<'a> {
                 fewest_stuck = self.stuck.len();
                 last_gain = self.relax;
             }
-            let give_up = self.relax >= self.opts.recovery_rounds
-                || self.relax >= last_gain + STALL_ROUNDS
-                || failed_fills >= FILL_TRIES;
+            let give_up =
+                self.relax >= self.opts.recovery_rounds || self.relax >= last_gain + STALL_ROUNDS;
             // The fill every `fill_after` rounds, and where the front would
             // give up.
             let due = self.opts.fill_after > 0
