@@ -1,5 +1,5 @@
 //! Fill the cavity in an OBJ file (faces pointing into it) and report:
-//! `cargo run --example fill_obj -- CAVITY.obj [MAX_STEINER MAX_STEINER_FACES MAX_SEARCH_FACES]`.
+//! `cargo run --example fill_obj -- CAVITY.obj [MAX_STEINER MAX_STEINER_FACES MAX_SEARCH_FACES [MAX_SPLIT]]`.
 use parafront_delaunay::{fill_cavity, FillOptions};
 use std::time::Instant;
 
@@ -52,6 +52,12 @@ fn main() {
     }
     if let Some(n) = arg(4) {
         opts.max_search_faces = n;
+    }
+    // A fifth argument N: the conforming fill alone, its edges split
+    // first, with at most N split points.
+    if let Some(n) = arg(5) {
+        opts.segments_first = true;
+        opts.max_split = n;
     }
     match fill_cavity(&pts, &faces, &opts) {
         Ok(f) => println!(

@@ -1,5 +1,7 @@
 //! Local re-triangulations that keep a triangulation valid: the 2-3 flip
-//! and edge removal (3-2, 4-4 and larger rings, by a fan over the ring).
+//! and edge removal (3-2, 4-4 and larger rings, by a fan over the ring),
+//! and their nested forms (a flip blocked by an edge removes that edge
+//! first, a few levels deep, as TetGen's flipnm).
 //! Each is tried, checked exactly, and done only when every new tet is
 //! positive; faces in `protect` are never removed.
 use crate::tri::{Triangulation, NONE, TET_FACES};
@@ -158,14 +160,28 @@ impl Triangulation {
     /// over the ring polygon joined to `p` and to `q` (a 3-2 flip for a
     /// ring of three, 4-4 for four). Every fan apex is tried.
     pub fn remove_edge(&mut self, p: u32, q: u32, protect: &FxHashSet<[u32; 3]>) -> Flip {
+        self.remove_edge_deep(p, q, protect, 0)
+    }
+
+    /// [`Triangulation::remove_edge`], where no fan is positive shrinking
+    /// the ring by 2-3 flips of the faces around the edge (each takes one
+    /// corner out of the ring; Shewchuk's edge removal by flips), each
+    /// flip itself [`Triangulation::flip23_deep`] to `depth` levels.
+    pub(crate) fn remove_edge_deep(
+        &mut self,
+        p: u32,
+        q: u32,
+        protect: &FxHashSet<[u32; 3]>,
+        depth: u32,
+    ) -> Flip {
         let r = self.remove_edge_fan(p, q, protect);
         if r != Flip::NotConvex {
             return r;
         }
-        // No fan is positive: shrink the ring by 2-3 flips of the faces
-        // around the edge (each takes one corner out of the ring), then
-        // try the fan again (Shewchuk's edge removal by flips).
-        loop {
+        let Some((_, ring0)) = self.edge_ring(p, q) else {
+            return Flip::NotApplicable;
+        };
+        for _ in 0..2 * ring0.len() + 8 {
             let Some((_, ring)) = self.edge_ring(p, q) else {
                 return Flip::NotApplicable;
             };
@@ -177,7 +193,7 @@ impl Triangulation {
                 let Some(fr) = self.find_face([p, q, r]) else {
                     continue;
                 };
-                if self.flip23(fr, protect) == Flip::Done {
+                if self.flip23_deep(fr, protect, depth, (p, q)) == Flip::Done {
                     shrunk = true;
                     break;
                 }
@@ -189,6 +205,42 @@ impl Triangulation {
                 return Flip::Done;
             }
         }
+        Flip::NotConvex
+    }
+
+    /// The 2-3 flip of face `fr`, or, where the edge between its two
+    /// apexes passes outside it across one of its edges (other than
+    /// `keep`), that edge's removal, to `depth` levels (TetGen's flipnm).
+    pub(crate) fn flip23_deep(
+        &mut self,
+        fr: u32,
+        protect: &FxHashSet<[u32; 3]>,
+        depth: u32,
+        keep: (u32, u32),
+    ) -> Flip {
+        let r = self.flip23(fr, protect);
+        if r != Flip::NotConvex || depth == 0 {
+            return r;
+        }
+        let (t, f) = (fr >> 2, (fr & 3) as usize);
+        let nb = self.neigh[fr as usize];
+        let tv = self.tets[t as usize];
+        let w = TET_FACES[f].map(|k| tv[k]);
+        let a = tv[f];
+        let b = self.tets[(nb >> 2) as usize][(nb & 3) as usize];
+        for i in 0..3 {
+            let (x, y) = (w[i], w[(i + 1) % 3]);
+            if (x, y) == keep || (y, x) == keep {
+                continue;
+            }
+            let pt = |v: u32| self.pts[v as usize];
+            if orient3d(pt(x), pt(y), pt(a), pt(b)) <= 0.0
+                && self.remove_edge_deep(x, y, protect, depth - 1) == Flip::Done
+            {
+                return Flip::Done;
+            }
+        }
+        Flip::NotConvex
     }
 
     fn remove_edge_fan(&mut self, p: u32, q: u32, protect: &FxHashSet<[u32; 3]>) -> Flip {

@@ -1,7 +1,8 @@
 //! Recovery of constraint faces by flips: an edge of the triangulation that
 //! pierces a missing face is removed (3-2, 4-4, ...), a face that a missing
 //! face's edge pierces is flipped 2-3, until the face appears or no flip
-//! applies. Faces already present are protected.
+//! applies. Each flip may first remove the edges that block it, two levels
+//! deep. Faces already present are protected.
 use crate::flips::{key3, Flip};
 use crate::tri::{Triangulation, NONE, TET_FACES};
 use parafront_geom::{add, cross, orient3d, sub, P3};
@@ -14,6 +15,16 @@ pub(crate) fn recover_all(
     cf: &[[u32; 3]],
     per_face: usize,
     flips: &mut usize,
+) -> Vec<usize> {
+    recover_all_at(tri, cf, per_face, flips, DEPTH)
+}
+
+fn recover_all_at(
+    tri: &mut Triangulation,
+    cf: &[[u32; 3]],
+    per_face: usize,
+    flips: &mut usize,
+    depth: u32,
 ) -> Vec<usize> {
     let mut missing: Vec<usize> = Vec::new();
     let mut protect: FxHashSet<[u32; 3]> = FxHashSet::default();
@@ -29,7 +40,7 @@ pub(crate) fn recover_all(
         let before = missing.len();
         let mut still = Vec::new();
         for &i in &missing {
-            if recover_face(tri, cf[i], &protect, per_face, flips) {
+            if recover_face(tri, cf[i], &protect, per_face, flips, depth) {
                 protect.insert(key3(cf[i]));
             } else {
                 still.push(i);
@@ -40,8 +51,16 @@ pub(crate) fn recover_all(
             break;
         }
     }
+    // A face another face's flips brought back is not missing.
+    missing.retain(|&i| tri.find_face(cf[i]).is_none());
     missing
 }
+
+/// Levels of nested flips (`flip23_deep`). On the thin cracks the front
+/// leaves on CAD parts (six cavities of 144-296 faces), plain flips left
+/// 20-144 faces missing, two levels 12-77, three 0-66 at several times the
+/// cost, four no fewer.
+const DEPTH: u32 = 2;
 
 fn recover_face(
     tri: &mut Triangulation,
@@ -49,6 +68,7 @@ fn recover_face(
     protect: &FxHashSet<[u32; 3]>,
     budget: usize,
     flips: &mut usize,
+    depth: u32,
 ) -> bool {
     for _ in 0..budget {
         if tri.find_face(f).is_some() {
@@ -57,14 +77,20 @@ fn recover_face(
         let (edges, faces) = crossings(tri, f);
         let mut done = false;
         for (u, v) in edges {
-            if tri.remove_edge(u, v, protect) == Flip::Done {
+            if tri.remove_edge_deep(u, v, protect, depth) == Flip::Done {
                 done = true;
                 break;
             }
         }
         if !done {
-            for fr in faces {
-                if tri.flip23(fr, protect) == Flip::Done {
+            // By corners: a nested flip that fails may still have changed
+            // the tets, and a face's slot then holds another tet.
+            let faces: Vec<[u32; 3]> = faces.iter().map(|&fr| tri.face_corners(fr)).collect();
+            for w in faces {
+                let Some(fr) = tri.find_face(w) else {
+                    continue;
+                };
+                if tri.flip23_deep(fr, protect, depth, (NONE, NONE)) == Flip::Done {
                     done = true;
                     break;
                 }
@@ -222,4 +248,50 @@ fn pierces(a: P3, b: P3, w: [P3; 3]) -> bool {
 #[inline]
 fn opp(a: f64, b: f64) -> bool {
     (a > 0.0 && b < 0.0) || (a < 0.0 && b > 0.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn read_obj(text: &str) -> (Vec<P3>, Vec<[u32; 3]>) {
+        let (mut pts, mut faces) = (Vec::new(), Vec::new());
+        for l in text.lines() {
+            let w: Vec<&str> = l.split_whitespace().collect();
+            match w.first() {
+                Some(&"v") => pts.push([1, 2, 3].map(|k| w[k].parse::<f64>().unwrap())),
+                Some(&"f") => faces.push([1, 2, 3].map(|k| w[k].parse::<u32>().unwrap() + 3)),
+                _ => {}
+            }
+        }
+        (pts, faces)
+    }
+
+    /// Thin cracks the front left on the tray and the hinge: nested flips
+    /// recover more of their faces than plain ones, keep the triangulation
+    /// valid (a nested flip that fails can still change the tets: the
+    /// hinge's crack once left a face linked to a tet that had been
+    /// replaced), and keep every face they recovered.
+    #[test]
+    fn nested_flips_recover_more_and_keep_the_triangulation_valid() {
+        for text in [
+            include_str!("../tests/data/tray_crack_150.obj"),
+            include_str!("../tests/data/tray_crack_188.obj"),
+            include_str!("../tests/data/hinge_crack_184.obj"),
+        ] {
+            let (pts, cf) = read_obj(text);
+            let mut missing = [0; 2];
+            for (k, depth) in [0, DEPTH].into_iter().enumerate() {
+                let mut tri = Triangulation::new(&pts).unwrap();
+                let mut flips = 0;
+                let still = recover_all_at(&mut tri, &cf, 8, &mut flips, depth);
+                tri.check().unwrap();
+                for (i, &f) in cf.iter().enumerate() {
+                    assert_eq!(tri.find_face(f).is_none(), still.contains(&i), "face {i}");
+                }
+                missing[k] = still.len();
+            }
+            assert!(missing[1] < missing[0], "{missing:?}");
+        }
+    }
 }

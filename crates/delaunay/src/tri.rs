@@ -445,6 +445,12 @@ impl Triangulation {
         out
     }
 
+    /// The corners of face `4t+f`.
+    pub(crate) fn face_corners(&self, fr: u32) -> [u32; 3] {
+        let tv = self.tets[(fr >> 2) as usize];
+        TET_FACES[(fr & 3) as usize].map(|k| tv[k])
+    }
+
     /// The tet face `4t+f` with corners `w` (any order), if it exists.
     pub fn find_face(&self, w: [u32; 3]) -> Option<u32> {
         for t in self.star(w[0]) {

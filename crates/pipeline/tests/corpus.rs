@@ -95,3 +95,20 @@ fn round_tube_thin_wall() {
     assert!(summary.regions_filled.is_empty());
     assert!(summary.fill_tets > 0);
 }
+
+#[test]
+fn tray_at_a_fortieth_of_its_size() {
+    // `--size 8.875` on a tray 355 wide and 3.2 thick, whose faces are up
+    // to 62 long: the front leaves thin cracks (1-3 % as thick as their
+    // faces are long) that the fill closed only once its flips were
+    // nested (a flip blocked by an edge removes that edge first).
+    let Some(dir) = corpus() else { return };
+    let s = read_surface(&dir.join("1002_tray_bottom.STL")).unwrap();
+    let mut o = MeshOptions::default();
+    o.size.h = Some(8.875);
+    let (m, summary) = mesh_surface(&s, &o).expect("the tray at size 8.875 meshes");
+    m.check_against_surface(&s.tris).expect("valid");
+    assert!(summary.cavities_filled > 0, "the fill closed cracks");
+    assert!(summary.regions_filled.is_empty());
+    assert!(m.tets.len() > s.tris.len(), "{} tets", m.tets.len());
+}
