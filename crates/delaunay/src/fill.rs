@@ -44,8 +44,9 @@ pub struct FillOptions {
     /// moved into the cavity at the end); 0 turns it off.
     pub max_split: usize,
     /// The conforming fill runs where flips left at most this many faces
-    /// missing: the tray's slab that it closes had 18, and the thin slot's
-    /// slabs at size 0.1, where it failed at 0.3-0.6 s each, 37-69.
+    /// missing. With nested flips the tray's cracks that it closes have
+    /// 14, and the thin slot's slabs at size 0.1, where it fails, 24-28:
+    /// at 32 it ran there, 2-5 s a slab, and the slot took 10 s, not 4.
     pub max_conform_missing: usize,
     /// Go straight to the conforming fill, its edges split first until
     /// each piece is an edge of the Delaunay triangulation (no flips,
@@ -66,7 +67,7 @@ impl Default for FillOptions {
             max_search_steiner: 20,
             max_search_faces: 400,
             max_split: 4096,
-            max_conform_missing: 32,
+            max_conform_missing: 20,
             segments_first: false,
         }
     }
