@@ -10,16 +10,9 @@ fn main() {
         .with_writer(std::io::stderr)
         .init();
     let path = std::env::args().nth(1).expect("usage: fill_obj CAVITY.obj");
-    let text = std::fs::read_to_string(&path).expect("read");
-    let (mut pts, mut faces) = (Vec::new(), Vec::new());
-    for l in text.lines() {
-        let w: Vec<&str> = l.split_whitespace().collect();
-        match w.first() {
-            Some(&"v") => pts.push([1, 2, 3].map(|k| w[k].parse::<f64>().expect("coordinate"))),
-            Some(&"f") => faces.push([1, 2, 3].map(|k| w[k].parse::<u32>().expect("index") - 1)),
-            _ => {}
-        }
-    }
+    let s = parafront_surface::read::read_surface(std::path::Path::new(&path))
+        .unwrap_or_else(|e| panic!("{e}"));
+    let (pts, faces) = (s.points, s.tris);
     // Faces that meet other than in shared corners (the cavity must be
     // embedded).
     let mut bad = 0;

@@ -222,11 +222,9 @@ impl Triangulation {
         if r != Flip::NotConvex || depth == 0 {
             return r;
         }
-        let (t, f) = (fr >> 2, (fr & 3) as usize);
         let nb = self.neigh[fr as usize];
-        let tv = self.tets[t as usize];
-        let w = TET_FACES[f].map(|k| tv[k]);
-        let a = tv[f];
+        let w = self.face_corners(fr);
+        let a = self.tets[(fr >> 2) as usize][(fr & 3) as usize];
         let b = self.tets[(nb >> 2) as usize][(nb & 3) as usize];
         for i in 0..3 {
             let (x, y) = (w[i], w[(i + 1) % 3]);

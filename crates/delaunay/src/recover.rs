@@ -254,17 +254,13 @@ fn opp(a: f64, b: f64) -> bool {
 mod tests {
     use super::*;
 
+    /// A cavity from an OBJ file, its faces in triangulation ids (after
+    /// the bounding tet's four corners).
     fn read_obj(text: &str) -> (Vec<P3>, Vec<[u32; 3]>) {
-        let (mut pts, mut faces) = (Vec::new(), Vec::new());
-        for l in text.lines() {
-            let w: Vec<&str> = l.split_whitespace().collect();
-            match w.first() {
-                Some(&"v") => pts.push([1, 2, 3].map(|k| w[k].parse::<f64>().unwrap())),
-                Some(&"f") => faces.push([1, 2, 3].map(|k| w[k].parse::<u32>().unwrap() + 3)),
-                _ => {}
-            }
-        }
-        (pts, faces)
+        use parafront_surface::read::{read_surface_bytes, Format};
+        let s = read_surface_bytes("cavity.obj", text.as_bytes(), Format::Obj).expect("OBJ");
+        let faces = s.tris.iter().map(|f| f.map(|v| v + 4)).collect();
+        (s.points, faces)
     }
 
     /// Thin cracks the front left on the tray and the hinge: nested flips

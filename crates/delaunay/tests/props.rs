@@ -283,17 +283,11 @@ proptest! {
     }
 }
 
+/// A cavity from an OBJ file (faces into it), by the surface crate's reader.
 fn read_obj(text: &str) -> (Vec<P3>, Vec<[u32; 3]>) {
-    let (mut pts, mut faces) = (Vec::new(), Vec::new());
-    for l in text.lines() {
-        let w: Vec<&str> = l.split_whitespace().collect();
-        match w.first() {
-            Some(&"v") => pts.push([1, 2, 3].map(|k| w[k].parse::<f64>().unwrap())),
-            Some(&"f") => faces.push([1, 2, 3].map(|k| w[k].parse::<u32>().unwrap() - 1)),
-            _ => {}
-        }
-    }
-    (pts, faces)
+    use parafront_surface::read::{read_surface_bytes, Format};
+    let s = read_surface_bytes("cavity.obj", text.as_bytes(), Format::Obj).expect("OBJ");
+    (s.points, s.tris)
 }
 
 /// A thin twisted cavity left by the front on round.stl (10 points on a

@@ -57,14 +57,13 @@ pub fn min_dihedral_deg(p: [P3; 4]) -> f64 {
     // were a fifth of the improvement's time), and the four face normals
     // instead of two cross products per edge (this function was a third
     // of the tray's improvement, and is a sixth).
-    // The edge is found by a key that grows with the angle: its sine while
-    // acute, 2 minus it after (`|m_k x m_l| = |e| |6V|`; sines, unlike
-    // cosines, resolve small angles).
     let Some(f) = Faces::new(p) else {
         return min_dihedral_slow(p);
     };
     // Every tet has an acute dihedral angle, and among acute ones the
-    // smallest has the smallest sine: `|e|^2 / (|m_k|^2 |m_l|^2)`.
+    // smallest has the smallest sine, `|e| |6V| / (|m_k| |m_l|)` (sines,
+    // unlike cosines, resolve small angles): the least
+    // `|e|^2 / (|m_k|^2 |m_l|^2)`.
     let mut best = (f64::INFINITY, 0, 0);
     for (e2, k, l) in f.edges() {
         if dot(f.m[k], f.m[l]) < 0.0 {
@@ -96,27 +95,37 @@ impl Faces {
     /// `None` where a face has no normal (a flat or non-finite tet).
     #[inline]
     fn new(p: [P3; 4]) -> Option<Faces> {
-        use parafront_geom::{cross, norm2, sub};
-        let (a, b, c) = (sub(p[1], p[0]), sub(p[2], p[0]), sub(p[3], p[0]));
-        let (ab, ac, bc) = (sub(b, a), sub(c, a), sub(c, b));
-        let m = [cross(ac, ab), cross(b, c), cross(c, a), cross(a, b)];
-        let n2 = m.map(norm2);
+        let (e, m) = edges_and_normals(p);
+        let n2 = m.map(parafront_geom::norm2);
         if !n2.iter().all(|&x| x > 0.0 && x.is_finite()) {
             return None;
         }
-        Some(Faces {
-            m,
-            n2,
-            e: [a, b, c, ab, ac, bc],
-        })
+        Some(Faces { m, n2, e })
     }
 
     /// Each edge's squared length with the two faces that meet there.
     #[inline]
     fn edges(&self) -> impl Iterator<Item = (f64, usize, usize)> + '_ {
-        const SIDES: [(usize, usize); 6] = [(2, 3), (1, 3), (1, 2), (0, 3), (0, 2), (0, 1)];
-        (0..6).map(move |i| (parafront_geom::norm2(self.e[i]), SIDES[i].0, SIDES[i].1))
+        (0..6).map(move |i| {
+            let (k, l) = EDGE_FACES[i];
+            (parafront_geom::norm2(self.e[i]), k, l)
+        })
     }
+}
+
+/// The faces (by opposite corner) that meet at edges 01, 02, 03, 12, 13, 23.
+const EDGE_FACES: [(usize, usize); 6] = [(2, 3), (1, 3), (1, 2), (0, 3), (0, 2), (0, 1)];
+
+/// A tet's edge vectors (01, 02, 03, 12, 13, 23) and its face normals
+/// (`m[i]` on the face opposite corner `i`, twice its area long, all
+/// inward for a positive tet).
+#[inline]
+fn edges_and_normals(p: [P3; 4]) -> ([P3; 6], [P3; 4]) {
+    use parafront_geom::{cross, sub};
+    let (a, b, c) = (sub(p[1], p[0]), sub(p[2], p[0]), sub(p[3], p[0]));
+    let (ab, ac, bc) = (sub(b, a), sub(c, a), sub(c, b));
+    let m = [cross(ac, ab), cross(b, c), cross(c, a), cross(a, b)];
+    ([a, b, c, ab, ac, bc], m)
 }
 
 /// Every edge's angle: for flat tets, where a normal vanishes.
@@ -137,23 +146,12 @@ fn min_dihedral_slow(p: [P3; 4]) -> f64 {
 /// without the arc tangents. At the edge of faces `k` and `l`,
 /// `|m_k x m_l| = |e| |6V|`.
 pub fn has_dihedral_under(p: [P3; 4], tan_max: f64) -> bool {
-    use parafront_geom::{cross, dot, norm2, sub};
-    let (a, b, c) = (sub(p[1], p[0]), sub(p[2], p[0]), sub(p[3], p[0]));
-    let (ab, ac, bc) = (sub(b, a), sub(c, a), sub(c, b));
-    let m = [cross(ac, ab), cross(b, c), cross(c, a), cross(a, b)];
-    let v6 = dot(a, m[1]);
+    use parafront_geom::{dot, norm2};
+    let (e, m) = edges_and_normals(p);
+    let v6 = dot(e[0], m[1]);
     let t2 = tan_max * tan_max;
     // Squared: `|e|^2 (6V)^2 < tan^2 c12^2`, no square roots.
-    [
-        (a, 2, 3),
-        (b, 1, 3),
-        (c, 1, 2),
-        (ab, 0, 3),
-        (ac, 0, 2),
-        (bc, 0, 1),
-    ]
-    .iter()
-    .any(|&(e, k, l)| {
+    e.iter().zip(EDGE_FACES).any(|(&e, (k, l))| {
         let c12 = -dot(m[k], m[l]);
         c12 > 0.0 && norm2(e) * v6 * v6 < t2 * c12 * c12
     })
