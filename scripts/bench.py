@@ -63,6 +63,13 @@ SETS = {
                                           "slot_1e-3", "boss_1e-4"]]
     + [("%slot_1e-2.obj", ["--size", "0.1"]), ("%slot_1e-3.obj", ["--size", "0.1"]),
        ("%boss_1e-4.obj", ["--size", "0.1"])],
+    # The CAD parts under a size finer than their needles (a tenth to a
+    # fortieth of their width), where the front leaves thin cracks and,
+    # when the cavity fill cannot close them, the region is filled whole.
+    "finer": [("valid/1002_tray_bottom.STL", ["--size", "8.875"]),
+              ("valid/plate_holes.STL", ["--size", "7.5"]),
+              ("valid/hinge.stl", ["--size", "2.5"]),
+              ("valid/hinge.stl", ["--size", "1.25"])],
     "bench1e5": [(f"bench/{n}_1e5.stl", []) for n in ["sphere", "torus", "box2holes", "spheres27"]],
     "bench1e6": [(f"bench/{n}_1e6.stl", []) for n in ["sphere", "torus"]],
     # Issue 21's other measure: a uniform size under which parafront makes

@@ -53,15 +53,24 @@ fn main() {
         opts.max_split = n;
     }
     match fill_cavity(&pts, &faces, &opts) {
-        Ok(f) => println!(
-            "{path}: {} faces: {} tets, {} Steiner points, {:?}, {} flips, {:.3} s",
-            faces.len(),
-            f.tets.len(),
-            f.steiner.len(),
-            f.method,
-            f.flips,
-            t0.elapsed().as_secs_f64()
-        ),
+        Ok(f) => {
+            let all: Vec<_> = pts.iter().chain(f.steiner.iter()).copied().collect();
+            // Tets flat in floating point (a solver reads them as inverted).
+            let flat = f
+                .tets
+                .iter()
+                .filter(|t| parafront_delaunay::is_flat(t.map(|v| all[v as usize])))
+                .count();
+            println!(
+                "{path}: {} faces: {} tets ({flat} flat in floating point), {} Steiner points, {:?}, {} flips, {:.3} s",
+                faces.len(),
+                f.tets.len(),
+                f.steiner.len(),
+                f.method,
+                f.flips,
+                t0.elapsed().as_secs_f64()
+            )
+        }
         Err(e) => println!(
             "{path}: {} faces: {e} ({:.3} s)",
             faces.len(),

@@ -11,28 +11,20 @@
 //! Steiner points in Si and Gärtner's constraint recovery: the surface
 //! keeps every given triangle and no point is left on it.
 //!
-//! With `segments_first`, the cavity's edges are split before any round
-//! until each piece is an edge of the Delaunay triangulation (Bowyer-Watson
-//! keeps it Delaunay, so no flips and no rebuild): on round.stl's 1,120
-//! needle faces, 602 points in 0.15 s, where flips left 296 faces missing.
-//! A surface whose split points crowd each other (two needles side by
-//! side) needs far more (plate_holes: 17,854 for 1,252 faces), and the
-//! budget stops it.
+//! `segments.rs` does the same in one triangulation, in TetGen's order
+//! (edges first, kept while the faces are recovered); the relocation here
+//! ends both.
 use crate::flips::key3;
 use crate::recover::{crossings, recover_all};
 use crate::tri::{Triangulation, TET_FACES};
-use parafront_geom::{
-    add, dist, kernel::deepest_point, normalize, orient2d, orient3d, scale, tri_normal, P3,
-};
+use parafront_geom::{add, dist, orient2d, orient3d, scale, tri_normal, P3};
 use rustc_hash::{FxHashMap, FxHashSet};
 
 /// Each cavity edge (lower id first) as its points in order.
-type Chains = FxHashMap<(u32, u32), Vec<u32>>;
+pub(crate) type Chains = FxHashMap<(u32, u32), Vec<u32>>;
 
 /// Triangulations built before the conforming fill gives up.
 const REBUILDS: usize = 24;
-/// Halvings of the step off the surface tried for a relocated point.
-const STEP_HALVINGS: usize = 40;
 
 /// The cavity's points (`lp`, each face's corners index it) and faces; a
 /// fill as Steiner points and tets over `lp` then the Steiner points, or
@@ -45,6 +37,10 @@ pub(crate) fn conform_fill(
     segments_first: bool,
 ) -> Option<(Vec<P3>, Vec<[u32; 4]>)> {
     let mut c = Conforming::new(lp, faces);
+    // Edges split until each piece is a Delaunay edge: round.stl's 1,120
+    // needle faces take 602 points in 0.15 s; a surface whose split points
+    // crowd each other (two needles side by side) needs far more
+    // (plate_holes: 17,854 for 1,252 faces), and the budget stops it.
     if segments_first {
         c.split_segments(lp.len(), max_split)?;
     }
@@ -75,7 +71,7 @@ pub(crate) fn conform_fill(
         if still.is_empty() {
             let kept = crate::fill::classify(&tri, &tf)?;
             let tets: Vec<[u32; 4]> = kept.iter().map(|&t| tri.tet(t).map(|v| v - 4)).collect();
-            return relocate(lp.len(), c.pts, &c.chains, tets, sub, origin, faces);
+            return crate::relocate::relocate(lp.len(), c.pts, &c.chains, tets, sub, origin, faces);
         }
         // Rounds that leave more pieces missing twice over are not
         // converging.
@@ -94,7 +90,7 @@ pub(crate) fn conform_fill(
             if c.pts.len() - lp.len() >= max_split {
                 return None;
             }
-            c.break_piece(&tri, piece, face);
+            c.break_piece(&tri, piece, face, true);
         }
     }
     None
@@ -102,15 +98,15 @@ pub(crate) fn conform_fill(
 
 /// The cavity's surface as it is split: its points, its edges' chains, and
 /// each face's pieces.
-struct Conforming {
-    pts: Vec<P3>,
-    chains: Chains,
-    faces: Vec<[u32; 3]>,
-    pieces: Vec<Vec<[u32; 3]>>,
+pub(crate) struct Conforming {
+    pub(crate) pts: Vec<P3>,
+    pub(crate) chains: Chains,
+    pub(crate) faces: Vec<[u32; 3]>,
+    pub(crate) pieces: Vec<Vec<[u32; 3]>>,
 }
 
 impl Conforming {
-    fn new(lp: &[P3], faces: &[[u32; 3]]) -> Conforming {
+    pub(crate) fn new(lp: &[P3], faces: &[[u32; 3]]) -> Conforming {
         let mut chains: Chains = FxHashMap::default();
         for f in faces {
             for k in 0..3 {
@@ -135,7 +131,7 @@ impl Conforming {
             let mut todo: Vec<(u32, u32)> = Vec::new();
             for ch in self.chains.values() {
                 for w in ch.windows(2) {
-                    if !has_edge(&tri, w[0] + 4, w[1] + 4) {
+                    if !tri.has_edge(w[0] + 4, w[1] + 4) {
                         todo.push((w[0], w[1]));
                     }
                 }
@@ -162,7 +158,7 @@ impl Conforming {
     }
 
     /// Every piece, and its face.
-    fn flat(&self) -> (Vec<[u32; 3]>, Vec<usize>) {
+    pub(crate) fn flat(&self) -> (Vec<[u32; 3]>, Vec<usize>) {
         let mut sub = Vec::new();
         let mut origin = Vec::new();
         for (i, ps) in self.pieces.iter().enumerate() {
@@ -178,13 +174,22 @@ impl Conforming {
     /// recover: the midpoint of an edge of it the triangulation lacks,
     /// else where an edge of the triangulation crosses it (which the point
     /// then removes), else its centroid.
-    fn break_piece(&mut self, tri: &Triangulation, piece: [u32; 3], face: usize) {
+    pub(crate) fn break_piece(
+        &mut self,
+        tri: &Triangulation,
+        piece: [u32; 3],
+        face: usize,
+        split_edges: bool,
+    ) {
         if !self.pieces[face].contains(&piece) {
             return; // already split this round
         }
         for k in 0..3 {
+            if !split_edges {
+                break;
+            }
             let (u, v) = (piece[k], piece[(k + 1) % 3]);
-            if !has_edge(tri, u + 4, v + 4) {
+            if !tri.has_edge(u + 4, v + 4) {
                 // The midpoint: splitting where a face in the way crosses
                 // the edge (as TetGen picks) left the tray's 158-face slab
                 // open, which midpoints close.
@@ -233,7 +238,7 @@ impl Conforming {
 
     /// Split edge `u`-`v` at `m`: the pieces on it (in every face) and its
     /// chain; an edge inside a face gets a chain of its own.
-    fn split_edge(&mut self, u: u32, v: u32, m: P3) {
+    pub(crate) fn split_edge(&mut self, u: u32, v: u32, m: P3) {
         let id = self.pts.len() as u32;
         self.pts.push(m);
         for ps in &mut self.pieces {
@@ -269,7 +274,7 @@ impl Conforming {
 /// input corner (`< n0`), where the piece from the corner gets a length
 /// that is a power of two (Ruppert's concentric shells), so that the
 /// splits of two edges at a small angle stop meeting.
-fn split_point(pts: &[P3], n0: usize, u: u32, v: u32) -> P3 {
+pub(crate) fn split_point(pts: &[P3], n0: usize, u: u32, v: u32) -> P3 {
     let (pu, pv) = (pts[u as usize], pts[v as usize]);
     let (iu, iv) = ((u as usize) < n0, (v as usize) < n0);
     if iu == iv {
@@ -296,7 +301,7 @@ fn mid(pts: &[P3], u: u32, v: u32) -> P3 {
 /// The triangulation's own triangles on face `i`'s points, when they
 /// tile it: as many as its pieces, none on one cavity edge, their areas
 /// adding up to the face's. Oriented as the face.
-fn dt_tiling(tri: &Triangulation, c: &Conforming, i: usize) -> Option<Vec<[u32; 3]>> {
+pub(crate) fn dt_tiling(tri: &Triangulation, c: &Conforming, i: usize) -> Option<Vec<[u32; 3]>> {
     let set: FxHashSet<u32> = c.pieces[i].iter().flatten().map(|&v| v + 4).collect();
     let n = tri_normal_of(&c.pts, c.faces[i]);
     let mut seen: FxHashSet<[u32; 3]> = FxHashSet::default();
@@ -338,15 +343,11 @@ fn between(chains: &Chains, a: u32, x: u32, c: u32) -> bool {
 }
 
 /// Points on one cavity edge (rounding may leave them not quite in line).
-fn one_chain(chains: &Chains, w: [u32; 3]) -> bool {
+pub(crate) fn one_chain(chains: &Chains, w: [u32; 3]) -> bool {
     chains.values().any(|c| w.iter().all(|v| c.contains(v)))
 }
 
-fn has_edge(tri: &Triangulation, u: u32, v: u32) -> bool {
-    tri.star(u).iter().any(|&t| tri.tet(t).contains(&v))
-}
-
-fn tri_normal_of(pts: &[P3], f: [u32; 3]) -> P3 {
+pub(crate) fn tri_normal_of(pts: &[P3], f: [u32; 3]) -> P3 {
     tri_normal(pts[f[0] as usize], pts[f[1] as usize], pts[f[2] as usize])
 }
 
@@ -365,7 +366,19 @@ fn project(p: P3, n: P3) -> [f64; 2] {
 
 /// A triangulation of the planar polygon `poly` (counter-clockwise seen
 /// from normal `n`) by ears, the fattest ear first.
+#[cfg(test)]
 fn ear_clip(pts: &[P3], chains: &Chains, poly: &[u32], n: P3) -> Option<Vec<[u32; 3]>> {
+    ear_clip_preferring(pts, chains, poly, n, &FxHashSet::default())
+}
+
+/// [`ear_clip`], taking ears in `prefer` (as [`key3`] keys) first.
+pub(crate) fn ear_clip_preferring(
+    pts: &[P3],
+    chains: &Chains,
+    poly: &[u32],
+    n: P3,
+    prefer: &FxHashSet<[u32; 3]>,
+) -> Option<Vec<[u32; 3]>> {
     if poly.len() < 3 {
         return None;
     }
@@ -400,7 +413,10 @@ fn ear_clip(pts: &[P3], chains: &Chains, poly: &[u32], n: P3) -> Option<Vec<[u32
             if blocked {
                 continue;
             }
-            let s = ear_shape(pts, a, b, c);
+            let mut s = ear_shape(pts, a, b, c);
+            if prefer.contains(&key3([a, b, c])) {
+                s += 1.0;
+            }
             if best.is_none_or(|(bs, _)| s > bs) {
                 best = Some((s, i));
             }
@@ -417,6 +433,27 @@ fn ear_clip(pts: &[P3], chains: &Chains, poly: &[u32], n: P3) -> Option<Vec<[u32
     Some(out)
 }
 
+/// The fans of the planar polygon `poly` (counter-clockwise seen from
+/// normal `n`) from each of its corners that has one.
+pub(crate) fn polygon_fans(pts: &[P3], chains: &Chains, poly: &[u32], n: P3) -> Vec<Vec<[u32; 3]>> {
+    let m = poly.len();
+    let q: Vec<[f64; 2]> = poly.iter().map(|&v| project(pts[v as usize], n)).collect();
+    let mut out = Vec::new();
+    'apex: for k in 0..m {
+        let mut fan = Vec::with_capacity(m - 2);
+        for i in 1..m - 1 {
+            let (a, b, c) = (k, (k + i) % m, (k + i + 1) % m);
+            let w = [poly[a], poly[b], poly[c]];
+            if orient2d(q[a], q[b], q[c]) <= 0.0 || one_chain(chains, w) {
+                continue 'apex;
+            }
+            fan.push(w);
+        }
+        out.push(fan);
+    }
+    out
+}
+
 /// Area over the squared edge lengths (scale-free).
 fn ear_shape(pts: &[P3], a: u32, b: u32, c: u32) -> f64 {
     let (pa, pb, pc) = (pts[a as usize], pts[b as usize], pts[c as usize]);
@@ -427,250 +464,10 @@ fn ear_shape(pts: &[P3], a: u32, b: u32, c: u32) -> f64 {
     area / l
 }
 
-/// Move each split point off the surface: its star's tets give way to the
-/// cone from a point just inside over the star's link and the faces it
-/// split, made whole without it (`sub` are the current surface pieces,
-/// `origin` their cavity faces). Checked: every tet positive, the surface
-/// exactly `faces`, the volume the cavity's.
-fn relocate(
-    n: usize,
-    mut pts: Vec<P3>,
-    chains: &Chains,
-    mut tets: Vec<[u32; 4]>,
-    mut sub: Vec<[u32; 3]>,
-    mut origin: Vec<usize>,
-    faces: &[[u32; 3]],
-) -> Option<(Vec<P3>, Vec<[u32; 4]>)> {
-    let split_points: Vec<u32> = (n as u32..pts.len() as u32).collect();
-    for s in split_points {
-        let star: Vec<usize> = (0..tets.len()).filter(|&t| tets[t].contains(&s)).collect();
-        // The link, each face seen from inside the hole.
-        let mut hole: Vec<[u32; 3]> = Vec::new();
-        for &t in &star {
-            let tv = tets[t];
-            let k = tv.iter().position(|&v| v == s)?;
-            let w = TET_FACES[k].map(|j| tv[j]);
-            hole.push([w[0], w[2], w[1]]);
-        }
-        // The surface pieces on `s`, by cavity face, made whole without it.
-        let mut by_face: Vec<(usize, Vec<usize>)> = Vec::new();
-        for (i, f) in sub.iter().enumerate() {
-            if f.contains(&s) {
-                match by_face.iter_mut().find(|(o, _)| *o == origin[i]) {
-                    Some((_, l)) => l.push(i),
-                    None => by_face.push((origin[i], vec![i])),
-                }
-            }
-        }
-        let mut patch: Vec<([u32; 3], usize)> = Vec::new();
-        let mut normals: Vec<P3> = Vec::new();
-        for (o, list) in &by_face {
-            let nrm = tri_normal_of(&pts, faces[*o]);
-            normals.push(normalize(nrm));
-            let poly = fan_polygon(&sub, list, s)?;
-            for p in ear_clip(&pts, chains, &poly, nrm)? {
-                patch.push((p, *o));
-            }
-        }
-        hole.extend(patch.iter().map(|(p, _)| *p));
-        let new_tets: Vec<[u32; 4]> = match cone_point(&pts, &hole, s, &normals) {
-            Some(q) => {
-                let qid = pts.len() as u32;
-                pts.push(q);
-                hole.iter().map(|w| [w[0], w[1], w[2], qid]).collect()
-            }
-            None => {
-                // No point sees the whole hole: it is a cavity of its own,
-                // filled without splits.
-                let opts = crate::fill::FillOptions {
-                    max_split: 0,
-                    ..Default::default()
-                };
-                let fill = match crate::fill::fill_cavity(&pts, &hole, &opts) {
-                    Ok(f) => f,
-                    Err(e) => {
-                        tracing::debug!(hole = hole.len(), error = %e, "conform: hole not filled");
-                        return None;
-                    }
-                };
-                pts.extend_from_slice(&fill.steiner);
-                fill.tets
-            }
-        };
-        let mut dead = vec![false; tets.len()];
-        for &t in &star {
-            dead[t] = true;
-        }
-        let mut next: Vec<[u32; 4]> = (0..tets.len())
-            .filter(|&t| !dead[t])
-            .map(|t| tets[t])
-            .collect();
-        next.extend(new_tets);
-        tets = next;
-        let keep: Vec<usize> = (0..sub.len()).filter(|&i| !sub[i].contains(&s)).collect();
-        sub = keep.iter().map(|&i| sub[i]).collect();
-        origin = keep.iter().map(|&i| origin[i]).collect();
-        for (p, o) in patch {
-            sub.push(p);
-            origin.push(o);
-        }
-    }
-    if verify(&pts, &tets, faces).is_none() {
-        tracing::debug!("conform: verify failed");
-        return None;
-    }
-    // Renumber: the cavity's points, then the relocated points in order.
-    let mut used: Vec<u32> = tets
-        .iter()
-        .flatten()
-        .copied()
-        .filter(|&v| v as usize >= n)
-        .collect();
-    used.sort_unstable();
-    used.dedup();
-    let id: FxHashMap<u32, u32> = used
-        .iter()
-        .enumerate()
-        .map(|(k, &v)| (v, (n + k) as u32))
-        .collect();
-    let steiner = used.iter().map(|&v| pts[v as usize]).collect();
-    let tets = tets
-        .iter()
-        .map(|t| t.map(|v| if (v as usize) < n { v } else { id[&v] }))
-        .collect();
-    Some((steiner, tets))
-}
-
-/// The outer chain of the fan of pieces `list` around `s`: from the
-/// corner after `s` on its edge round to the one before it, or the whole
-/// ring when `s` is inside the face.
-fn fan_polygon(sub: &[[u32; 3]], list: &[usize], s: u32) -> Option<Vec<u32>> {
-    // Each piece (s, x, y) in its cyclic order gives the chain step x -> y.
-    let mut next: FxHashMap<u32, u32> = FxHashMap::default();
-    let mut has_in: FxHashSet<u32> = FxHashSet::default();
-    for &i in list {
-        let f = sub[i];
-        let k = f.iter().position(|&v| v == s)?;
-        let (x, y) = (f[(k + 1) % 3], f[(k + 2) % 3]);
-        if next.insert(x, y).is_some() {
-            return None;
-        }
-        has_in.insert(y);
-    }
-    // A point on an edge has a path of pieces on each face; one inside a
-    // face has a closed fan.
-    let open = next.keys().filter(|x| !has_in.contains(x)).min().copied();
-    let start = match open {
-        Some(v) => v,
-        None => *next.keys().min()?,
-    };
-    let mut chain = vec![start];
-    let mut v = start;
-    while let Some(&w) = next.get(&v) {
-        if w == start {
-            break;
-        }
-        chain.push(w);
-        v = w;
-        if chain.len() > list.len() + 1 {
-            return None;
-        }
-    }
-    let want = if open.is_some() {
-        list.len() + 1
-    } else {
-        list.len()
-    };
-    (chain.len() == want).then_some(chain)
-}
-
-/// A point that sees every face of `hole` from inside: the kernel's deepest
-/// point, else `s` moved into the cavity along the faces' `normals`, a step
-/// halved until it sees them all.
-fn cone_point(pts: &[P3], hole: &[[u32; 3]], s: u32, normals: &[P3]) -> Option<P3> {
-    let sees = |q: P3| {
-        hole.iter().all(|w| {
-            let p = w.map(|v| pts[v as usize]);
-            orient3d(p[0], p[1], p[2], q) > 0.0
-        })
-    };
-    let planes: Vec<(P3, P3)> = hole
-        .iter()
-        .map(|w| {
-            let p = w.map(|v| pts[v as usize]);
-            (p[0], tri_normal(p[0], p[1], p[2]))
-        })
-        .collect();
-    if let Some((q, depth)) = deepest_point(&planes) {
-        if depth > 0.0 && q.iter().all(|x| x.is_finite()) && sees(q) {
-            return Some(q);
-        }
-    }
-    let ps = pts[s as usize];
-    let d = normalize(normals.iter().fold([0.0; 3], |a, &b| add(a, b)));
-    let mut step = hole
-        .iter()
-        .flatten()
-        .map(|&v| dist(pts[v as usize], ps))
-        .fold(f64::INFINITY, f64::min)
-        * 0.25;
-    for _ in 0..STEP_HALVINGS {
-        let q = add(ps, scale(d, step));
-        if sees(q) {
-            return Some(q);
-        }
-        step *= 0.5;
-    }
-    None
-}
-
-/// Every tet positive, every inner face in two tets from either side, the
-/// outer faces exactly the cavity's faces, and the tets' volume the
-/// cavity's.
-fn verify(pts: &[P3], tets: &[[u32; 4]], faces: &[[u32; 3]]) -> Option<()> {
-    let mut open: FxHashMap<[u32; 3], [u32; 3]> = FxHashMap::default();
-    let mut vol = 0.0;
-    for t in tets {
-        let p = t.map(|v| pts[v as usize]);
-        let o = orient3d(p[0], p[1], p[2], p[3]);
-        if !(o > 0.0) {
-            return None;
-        }
-        vol += o;
-        for fv in TET_FACES {
-            let w = fv.map(|j| t[j]);
-            let k = key3(w);
-            match open.remove(&k) {
-                Some(o) if !crate::flips::same_cycle(o, w) => {}
-                Some(_) => return None,
-                None => {
-                    open.insert(k, w);
-                }
-            }
-        }
-    }
-    if open.len() != faces.len() {
-        return None;
-    }
-    let o = pts[faces[0][0] as usize];
-    let mut cav = 0.0;
-    for f in faces {
-        // A cavity face's outward tet face is the face reversed.
-        let w = *open.get(&key3(*f))?;
-        if !crate::flips::same_cycle([f[0], f[2], f[1]], w) {
-            return None;
-        }
-        let p = f.map(|v| pts[v as usize]);
-        cav += orient3d(p[0], p[1], p[2], o);
-    }
-    let ok = tets.iter().flatten().all(|&v| (v as usize) < pts.len())
-        && (vol - cav).abs() <= 1e-9 * cav.abs().max(f64::MIN_POSITIVE);
-    ok.then_some(())
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::relocate::verify;
 
     #[test]
     fn ears_skip_a_split_point_on_the_new_edge() {

@@ -27,6 +27,13 @@ pub(crate) fn key3(mut w: [u32; 3]) -> [u32; 3] {
     w
 }
 
+/// A protected edge's key in a set of face keys: its ends in order, then
+/// `NONE`, which no face holds.
+#[inline]
+pub(crate) fn edge_key(u: u32, v: u32) -> [u32; 3] {
+    [u.min(v), u.max(v), NONE]
+}
+
 /// Whether `a` and `b` are the same oriented triangle (one a rotation of
 /// the other).
 #[inline]
@@ -118,10 +125,12 @@ impl Triangulation {
     /// The tets around edge `p`-`q` and the ring of their other corners in
     /// order, or `None` when the ring is open or the edge is missing.
     pub(crate) fn edge_ring(&self, p: u32, q: u32) -> Option<(Vec<u32>, Vec<u32>)> {
+        // Not from a bounding corner, whose star holds the hull.
+        let (a, b) = if p < 4 { (q, p) } else { (p, q) };
         let tets: Vec<u32> = self
-            .star(p)
+            .star(a)
             .into_iter()
-            .filter(|&t| self.tets[t as usize].contains(&q))
+            .filter(|&t| self.tets[t as usize].contains(&b))
             .collect();
         if tets.len() < 3 {
             return None;
@@ -246,6 +255,9 @@ impl Triangulation {
             return Flip::NotApplicable;
         };
         let n = ring.len();
+        if protect.contains(&edge_key(p, q)) {
+            return Flip::Protected;
+        }
         for &r in &ring {
             if protect.contains(&key3([p, q, r])) {
                 return Flip::Protected;

@@ -18,11 +18,12 @@
 //! Steiner points strictly inside the cavity at its dead ends), then the
 //! conforming fill (the missing edges split in the triangulation, the
 //! split points then moved off the surface into the cavity, after Si and
-//! Gärtner), then Steiner points in the triangulation. A front that
-//! stalls on its whole input asks for the conforming fill alone, its
-//! edges split first until each piece is a Delaunay edge
-//! (`FillOptions::segments_first`): flips on thousands of faces cost
-//! seconds, and a surface of needles needs less than a point per face.
+//! Gärtner), then Steiner points in the triangulation. A whole region
+//! (`FillOptions::segments_first`) is filled in TetGen's order, in one
+//! triangulation: its edges recovered by flips and kept, an edge flips
+//! cannot recover split at a point inserted without undoing what is kept
+//! (a constrained Bowyer-Watson cavity), then its faces, then the split
+//! points moved inside.
 //!
 //! [`refine_to_size`] is GDT's next step: it refines a filled region to a
 //! size field by Bowyer-Watson insertion of seeds (a lattice) and of
@@ -31,16 +32,20 @@
 #![warn(missing_docs)]
 mod check;
 mod conform;
+mod constrained;
 mod fill;
 mod flips;
 mod predicates;
 mod recover;
 mod refine;
+mod relocate;
 mod search;
+mod segments;
 mod tri;
 
 pub use check::CheckError;
 pub use fill::{fill_cavity, Fill, FillError, FillMethod, FillOptions};
 pub use flips::Flip;
+pub use predicates::{is_flat, FLAT};
 pub use refine::{refine_to_size, RefineError, RefineOptions, Refined};
 pub use tri::{InsertError, Triangulation, NONE, TET_FACES};

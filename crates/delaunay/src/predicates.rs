@@ -33,6 +33,23 @@ pub(crate) fn in_sphere_sos(t: [u32; 4], p: [P3; 4], ie: u32, e: P3) -> bool {
     false
 }
 
+/// Six times a tet's volume under this much of its longest edge cubed
+/// reads as flat to a checker in floating point that measures volumes
+/// against the mesh's mean edge (four corners on one plane of a CAD
+/// surface, positive only by rounding; a point a hair off a face).
+pub const FLAT: f64 = 1e-10;
+
+/// Tet `p` is flat, or negative, in floating point ([`FLAT`]).
+pub fn is_flat(p: [P3; 4]) -> bool {
+    let mut l2: f64 = 0.0;
+    for i in 0..4 {
+        for j in i + 1..4 {
+            l2 = l2.max(parafront_geom::dist2(p[i], p[j]));
+        }
+    }
+    !(parafront_geom::tet_volume6(p[0], p[1], p[2], p[3]) >= FLAT * l2 * l2.sqrt())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -1,8 +1,10 @@
-//! Recovery of constraint faces by flips: an edge of the triangulation that
-//! pierces a missing face is removed (3-2, 4-4, ...), a face that a missing
-//! face's edge pierces is flipped 2-3, until the face appears or no flip
-//! applies. Each flip may first remove the edges that block it, two levels
-//! deep. Faces already present are protected.
+//! Recovery of constraint faces and edges by flips: an edge of the
+//! triangulation that pierces a missing face (or that a missing edge
+//! passes through) is removed (3-2, 4-4, ...), a face that a missing face's
+//! edge (or a missing edge) pierces is flipped 2-3, until the face or edge
+//! appears or no flip applies. Each flip may first remove the edges that
+//! block it, two levels deep. Faces and edges already present are
+//! protected.
 use crate::flips::{key3, Flip};
 use crate::tri::{Triangulation, NONE, TET_FACES};
 use parafront_geom::{add, cross, orient3d, sub, P3};
@@ -26,8 +28,21 @@ fn recover_all_at(
     flips: &mut usize,
     depth: u32,
 ) -> Vec<usize> {
-    let mut missing: Vec<usize> = Vec::new();
     let mut protect: FxHashSet<[u32; 3]> = FxHashSet::default();
+    recover_faces(tri, cf, &mut protect, per_face, flips, depth)
+}
+
+/// [`recover_all`] keeping the faces and edges (`edge_key`) in `protect`
+/// besides the faces of `cf` found or recovered, which join it.
+pub(crate) fn recover_faces(
+    tri: &mut Triangulation,
+    cf: &[[u32; 3]],
+    protect: &mut FxHashSet<[u32; 3]>,
+    per_face: usize,
+    flips: &mut usize,
+    depth: u32,
+) -> Vec<usize> {
+    let mut missing: Vec<usize> = Vec::new();
     for (i, &f) in cf.iter().enumerate() {
         if tri.find_face(f).is_some() {
             protect.insert(key3(f));
@@ -40,7 +55,7 @@ fn recover_all_at(
         let before = missing.len();
         let mut still = Vec::new();
         for &i in &missing {
-            if recover_face(tri, cf[i], &protect, per_face, flips, depth) {
+            if recover_face(tri, cf[i], protect, per_face, flips, depth) {
                 protect.insert(key3(cf[i]));
             } else {
                 still.push(i);
@@ -56,11 +71,175 @@ fn recover_all_at(
     missing
 }
 
+/// Recover edge `a`-`b` by flips: the edges it crosses are removed and the
+/// faces it pierces flipped 2-3, nested to `depth` levels.
+pub(crate) fn recover_edge(
+    tri: &mut Triangulation,
+    a: u32,
+    b: u32,
+    protect: &FxHashSet<[u32; 3]>,
+    budget: usize,
+    flips: &mut usize,
+    depth: u32,
+) -> bool {
+    for _ in 0..budget {
+        if tri.has_edge(a, b) {
+            return true;
+        }
+        let (edges, faces) = segment_crossings(tri, a, b);
+        let mut done = false;
+        for (u, v) in edges {
+            if tri.remove_edge_deep(u, v, protect, depth) == Flip::Done {
+                done = true;
+                break;
+            }
+        }
+        if !done {
+            let faces: Vec<[u32; 3]> = faces.iter().map(|&fr| tri.face_corners(fr)).collect();
+            for w in faces {
+                let Some(fr) = tri.find_face(w) else {
+                    continue;
+                };
+                if tri.flip23_deep(fr, protect, depth, (NONE, NONE)) == Flip::Done {
+                    done = true;
+                    break;
+                }
+            }
+        }
+        if !done {
+            return false;
+        }
+        *flips += 1;
+    }
+    tri.has_edge(a, b)
+}
+
+/// The edges segment `a`-`b` passes through (their interiors) and the
+/// faces it pierces, in order from `a`.
+fn segment_crossings(tri: &Triangulation, a: u32, b: u32) -> (Vec<(u32, u32)>, Vec<u32>) {
+    let (pa, pb) = (tri.pts[a as usize], tri.pts[b as usize]);
+    let mut lo = pa;
+    let mut hi = pa;
+    for k in 0..3 {
+        lo[k] = lo[k].min(pb[k]);
+        hi[k] = hi[k].max(pb[k]);
+    }
+    let mut seen: FxHashSet<u32> = FxHashSet::default();
+    let mut near: Vec<u32> = Vec::new();
+    for t in tri.star(a) {
+        if seen.insert(t) {
+            near.push(t);
+        }
+    }
+    let mut i = 0;
+    while i < near.len() {
+        let t = near[i];
+        i += 1;
+        for k in 0..4 {
+            let nb = tri.neighbour(t, k);
+            if nb == NONE || seen.contains(&(nb >> 2)) {
+                continue;
+            }
+            let u = nb >> 2;
+            let tp = tri.tet_points(u);
+            let meets = (0..3)
+                .all(|d| tp.iter().any(|q| q[d] >= lo[d]) && tp.iter().any(|q| q[d] <= hi[d]))
+                && segment_near_tet(pa, pb, &tp);
+            seen.insert(u);
+            if meets {
+                near.push(u);
+            }
+        }
+    }
+    // (distance along the segment, the face, the edge it passes through).
+    type Hit = (f64, u32, Option<(u32, u32)>);
+    let mut hits: Vec<Hit> = Vec::new();
+    let mut fseen: FxHashSet<[u32; 3]> = FxHashSet::default();
+    let d = sub(pb, pa);
+    for &t in &near {
+        let tv = tri.tet(t);
+        for k in 0..4 {
+            let w = TET_FACES[k].map(|j| tv[j]);
+            if w.contains(&a)
+                || w.contains(&b)
+                || tri.neighbour(t, k) == NONE
+                || !fseen.insert(key3(w))
+            {
+                continue;
+            }
+            let wp = w.map(|v| tri.pts[v as usize]);
+            if !pierces(pa, pb, wp) {
+                continue;
+            }
+            // The edge it passes through, if any.
+            let s = [
+                orient3d(pa, pb, wp[0], wp[1]),
+                orient3d(pa, pb, wp[1], wp[2]),
+                orient3d(pa, pb, wp[2], wp[0]),
+            ];
+            let e = (0..3)
+                .find(|&e| s[e] == 0.0)
+                .map(|e| (w[e], w[(e + 1) % 3]));
+            let c = [0, 1, 2].map(|j| (wp[0][j] + wp[1][j] + wp[2][j]) / 3.0);
+            let along = (0..3).map(|j| (c[j] - pa[j]) * d[j]).sum::<f64>();
+            hits.push((along, 4 * t + k as u32, e));
+        }
+    }
+    hits.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
+    let mut edges: Vec<(u32, u32)> = Vec::new();
+    let mut faces = Vec::new();
+    for (_, fr, e) in hits {
+        if let Some((u, v)) = e {
+            let k = (u.min(v), u.max(v));
+            if !edges.contains(&k) {
+                edges.push(k);
+            }
+        }
+        faces.push(fr);
+    }
+    (edges, faces)
+}
+
+/// Segment `a`-`b` comes within rounding of tet `tp` (clipped by its
+/// four face planes, each moved out by a relative tolerance, something is
+/// left): a float filter that keeps every tet the segment meets.
+fn segment_near_tet(a: P3, b: P3, tp: &[P3; 4]) -> bool {
+    let d = sub(b, a);
+    let (mut t0, mut t1) = (0.0f64, 1.0f64);
+    for f in TET_FACES {
+        let (p, q, r) = (tp[f[0]], tp[f[1]], tp[f[2]]);
+        // Outward for a positive tet.
+        let n = cross(sub(q, p), sub(r, p));
+        let scale = n[0].abs() + n[1].abs() + n[2].abs();
+        let ap = sub(a, p);
+        let size = ap[0].abs() + ap[1].abs() + ap[2].abs() + d[0].abs() + d[1].abs() + d[2].abs();
+        let tol = 1e-9 * scale * size;
+        let num = n[0] * ap[0] + n[1] * ap[1] + n[2] * ap[2] - tol;
+        let den = n[0] * d[0] + n[1] * d[1] + n[2] * d[2];
+        if den == 0.0 {
+            if num > 0.0 {
+                return false;
+            }
+        } else {
+            let t = -num / den;
+            if den > 0.0 {
+                t1 = t1.min(t);
+            } else {
+                t0 = t0.max(t);
+            }
+            if t0 > t1 {
+                return false;
+            }
+        }
+    }
+    true
+}
+
 /// Levels of nested flips (`flip23_deep`). On the thin cracks the front
 /// leaves on CAD parts (six cavities of 144-296 faces), plain flips left
 /// 20-144 faces missing, two levels 12-77, three 0-66 at several times the
 /// cost, four no fewer.
-const DEPTH: u32 = 2;
+pub(crate) const DEPTH: u32 = 2;
 
 fn recover_face(
     tri: &mut Triangulation,

@@ -45,6 +45,9 @@ pub struct Triangulation {
     conflict: Vec<u32>,
     pub(crate) mark: Vec<u32>,
     epoch: u32,
+    /// Scratch for [`Triangulation::star`]: a mark per tet slot and its
+    /// epoch.
+    star_mark: std::cell::RefCell<(Vec<u32>, u32)>,
 }
 
 impl Triangulation {
@@ -109,6 +112,7 @@ impl Triangulation {
             conflict: Vec::new(),
             mark: vec![0],
             epoch: 0,
+            star_mark: Default::default(),
         })
         .map(|mut t| {
             for k in 0..4 {
@@ -425,8 +429,16 @@ impl Triangulation {
             }
         }
         let mut out = vec![t0];
-        let mut seen = rustc_hash::FxHashSet::default();
-        seen.insert(t0);
+        let mut scratch = self.star_mark.borrow_mut();
+        let (marks, epoch) = &mut *scratch;
+        *epoch = epoch.wrapping_add(1);
+        if *epoch == 0 {
+            marks.iter_mut().for_each(|m| *m = 0);
+            *epoch = 1;
+        }
+        let ep = *epoch;
+        marks.resize(self.tets.len(), 0);
+        marks[t0 as usize] = ep;
         let mut i = 0;
         while i < out.len() {
             let t = out[i];
@@ -437,7 +449,8 @@ impl Triangulation {
                     continue; // the face opposite v does not hold it
                 }
                 let nb = self.neigh[4 * t as usize + f];
-                if nb != NONE && seen.insert(nb >> 2) {
+                if nb != NONE && marks[(nb >> 2) as usize] != ep {
+                    marks[(nb >> 2) as usize] = ep;
                     out.push(nb >> 2);
                 }
             }
@@ -451,9 +464,19 @@ impl Triangulation {
         TET_FACES[(fr & 3) as usize].map(|k| tv[k])
     }
 
+    /// Whether `u`-`v` is an edge of a live tet.
+    pub(crate) fn has_edge(&self, u: u32, v: u32) -> bool {
+        // Not from a bounding corner, whose star holds the hull.
+        let (u, v) = if u < 4 { (v, u) } else { (u, v) };
+        self.star(u)
+            .iter()
+            .any(|&t| self.tets[t as usize].contains(&v))
+    }
+
     /// The tet face `4t+f` with corners `w` (any order), if it exists.
     pub fn find_face(&self, w: [u32; 3]) -> Option<u32> {
-        for t in self.star(w[0]) {
+        let a = w.iter().copied().find(|&x| x >= 4).unwrap_or(w[0]);
+        for t in self.star(a) {
             let tv = self.tets[t as usize];
             if w.iter().all(|x| tv.contains(x)) {
                 let f = (0..4).find(|&k| !w.contains(&tv[k])).unwrap();

@@ -448,3 +448,27 @@ proptest! {
         refined(&pts, &faces, 1.0 / k);
     }
 }
+
+/// The whole hinge (1,212 CAD faces, needles down to 0.33°, genus 5) as
+/// one cavity, its edges first (TetGen's order): flips recover most edges,
+/// the rest are split at points inserted without undoing what is kept,
+/// the faces follow, and the split points move inside. Splitting until each
+/// piece was a Delaunay edge and triangulating afresh (before) ran out of
+/// its budget of a point per face.
+#[test]
+fn fills_the_whole_hinge_with_its_edges_first() {
+    let (pts, faces) = read_obj(include_str!("data/hinge_surface.obj"));
+    let opts = FillOptions {
+        segments_first: true,
+        ..FillOptions::default()
+    };
+    let f = fill_cavity(&pts, &faces, &opts).expect("fill");
+    verify(&pts, &faces, &f);
+    assert_eq!(f.method, FillMethod::Conform);
+    // A few interior points, far under a point per face.
+    assert!(
+        f.steiner.len() < faces.len() / 8,
+        "{} Steiner points",
+        f.steiner.len()
+    );
+}

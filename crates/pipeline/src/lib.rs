@@ -580,7 +580,10 @@ fn serial_region(
             let fill = parafront_delaunay::fill_cavity(
                 &points,
                 &rf.faces,
-                &parafront_delaunay::FillOptions::default(),
+                &parafront_delaunay::FillOptions {
+                    segments_first: true,
+                    ..Default::default()
+                },
             )
             .map_err(|_| MeshError::Front { region, source: e })?;
             let mut all = points;

@@ -112,3 +112,25 @@ fn tray_at_a_fortieth_of_its_size() {
     assert!(summary.regions_filled.is_empty());
     assert!(m.tets.len() > s.tris.len(), "{} tets", m.tets.len());
 }
+
+#[test]
+fn hinge_at_a_twentieth_of_its_size() {
+    // `--size 2.5` on a hinge 50 wide whose CAD needles are up to 20 long:
+    // the front stalls on thin cracks it cannot close, and the whole region
+    // goes to the constrained fill, its edges recovered first and kept
+    // (TetGen's order), then refined to the size. Before, the fill failed
+    // on the whole surface too and the run ended with an error.
+    let Some(dir) = corpus() else { return };
+    let s = read_surface(&dir.join("hinge.stl")).unwrap();
+    let mut o = MeshOptions::default();
+    o.size.h = Some(2.5);
+    let (m, summary) = mesh_surface(&s, &o).expect("the hinge at size 2.5 meshes");
+    m.check_against_surface(&s.tris).expect("valid");
+    assert_eq!(summary.regions_filled, vec![1]);
+    // Refined to the size: several times the surface's points.
+    assert!(
+        m.points.len() > 2 * s.points.len(),
+        "{} points",
+        m.points.len()
+    );
+}

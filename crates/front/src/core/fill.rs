@@ -101,8 +101,9 @@ impl<'a> Front<'a> {
             }
         };
         // Exactly positive is valid; a tet flat in floating point (a split
-        // point moved a hair off the surface) would be the improvement's to
-        // undo, and the front's tets serve better.
+        // point moved a hair off the surface, four corners on one CAD
+        // plane) would be the improvement's to undo, and the front's tets
+        // serve better.
         let n = self.pts.len();
         let at = |v: u32| {
             let v = v as usize;
@@ -114,7 +115,7 @@ impl<'a> Front<'a> {
         };
         if fill.tets.iter().any(|t| {
             let p = t.map(at);
-            !(tet_volume6(p[0], p[1], p[2], p[3]) > 0.0)
+            parafront_delaunay::is_flat(p)
         }) {
             tracing::debug!("region fill has a tet flat in floating point");
             return false;
