@@ -87,26 +87,7 @@ pub(crate) fn recover_edge(
             return true;
         }
         let (edges, faces) = segment_crossings(tri, a, b);
-        let mut done = false;
-        for (u, v) in edges {
-            if tri.remove_edge_deep(u, v, protect, depth) == Flip::Done {
-                done = true;
-                break;
-            }
-        }
-        if !done {
-            let faces: Vec<[u32; 3]> = faces.iter().map(|&fr| tri.face_corners(fr)).collect();
-            for w in faces {
-                let Some(fr) = tri.find_face(w) else {
-                    continue;
-                };
-                if tri.flip23_deep(fr, protect, depth, (NONE, NONE)) == Flip::Done {
-                    done = true;
-                    break;
-                }
-            }
-        }
-        if !done {
+        if !flip_one(tri, &edges, &faces, protect, depth) {
             return false;
         }
         *flips += 1;
@@ -254,33 +235,41 @@ fn recover_face(
             return true;
         }
         let (edges, faces) = crossings(tri, f);
-        let mut done = false;
-        for (u, v) in edges {
-            if tri.remove_edge_deep(u, v, protect, depth) == Flip::Done {
-                done = true;
-                break;
-            }
-        }
-        if !done {
-            // By corners: a nested flip that fails may still have changed
-            // the tets, and a face's slot then holds another tet.
-            let faces: Vec<[u32; 3]> = faces.iter().map(|&fr| tri.face_corners(fr)).collect();
-            for w in faces {
-                let Some(fr) = tri.find_face(w) else {
-                    continue;
-                };
-                if tri.flip23_deep(fr, protect, depth, (NONE, NONE)) == Flip::Done {
-                    done = true;
-                    break;
-                }
-            }
-        }
-        if !done {
+        if !flip_one(tri, &edges, &faces, protect, depth) {
             return false;
         }
         *flips += 1;
     }
     tri.find_face(f).is_some()
+}
+
+/// One flip out of the way: the first of the blocking `edges` that can be
+/// removed, else the first of the pierced `faces` (slots) that can be
+/// flipped 2-3, each nested to `depth` levels; whether one was.
+fn flip_one(
+    tri: &mut Triangulation,
+    edges: &[(u32, u32)],
+    faces: &[u32],
+    protect: &FxHashSet<[u32; 3]>,
+    depth: u32,
+) -> bool {
+    for &(u, v) in edges {
+        if tri.remove_edge_deep(u, v, protect, depth) == Flip::Done {
+            return true;
+        }
+    }
+    // By corners: a nested flip that fails may still have changed the
+    // tets, and a face's slot then holds another tet.
+    let faces: Vec<[u32; 3]> = faces.iter().map(|&fr| tri.face_corners(fr)).collect();
+    for w in faces {
+        let Some(fr) = tri.find_face(w) else {
+            continue;
+        };
+        if tri.flip23_deep(fr, protect, depth, (NONE, NONE)) == Flip::Done {
+            return true;
+        }
+    }
+    false
 }
 
 /// The triangulation's edges that meet face `f` (outside its own edges),
