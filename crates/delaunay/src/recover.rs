@@ -99,39 +99,7 @@ pub(crate) fn recover_edge(
 /// faces it pierces, in order from `a`.
 fn segment_crossings(tri: &Triangulation, a: u32, b: u32) -> (Vec<(u32, u32)>, Vec<u32>) {
     let (pa, pb) = (tri.pts[a as usize], tri.pts[b as usize]);
-    let mut lo = pa;
-    let mut hi = pa;
-    for k in 0..3 {
-        lo[k] = lo[k].min(pb[k]);
-        hi[k] = hi[k].max(pb[k]);
-    }
-    let mut seen: FxHashSet<u32> = FxHashSet::default();
-    let mut near: Vec<u32> = Vec::new();
-    for t in tri.star(a) {
-        if seen.insert(t) {
-            near.push(t);
-        }
-    }
-    let mut i = 0;
-    while i < near.len() {
-        let t = near[i];
-        i += 1;
-        for k in 0..4 {
-            let nb = tri.neighbour(t, k);
-            if nb == NONE || seen.contains(&(nb >> 2)) {
-                continue;
-            }
-            let u = nb >> 2;
-            let tp = tri.tet_points(u);
-            let meets = (0..3)
-                .all(|d| tp.iter().any(|q| q[d] >= lo[d]) && tp.iter().any(|q| q[d] <= hi[d]))
-                && segment_near_tet(pa, pb, &tp);
-            seen.insert(u);
-            if meets {
-                near.push(u);
-            }
-        }
-    }
+    let near = tets_near(tri, &[a], &[pa, pb], |tp| segment_near_tet(pa, pb, tp));
     // (distance along the segment, the face, the edge it passes through).
     type Hit = (f64, u32, Option<(u32, u32)>);
     let mut hits: Vec<Hit> = Vec::new();
@@ -243,6 +211,55 @@ fn recover_face(
     tri.find_face(f).is_some()
 }
 
+/// The tets around the points `from` and those reached from them, across
+/// faces, whose box meets the box of `corners` and that `keep` takes (the
+/// near tets of a face or a segment).
+fn tets_near(
+    tri: &Triangulation,
+    from: &[u32],
+    corners: &[P3],
+    keep: impl Fn(&[P3; 4]) -> bool,
+) -> Vec<u32> {
+    let mut lo = corners[0];
+    let mut hi = corners[0];
+    for q in &corners[1..] {
+        for k in 0..3 {
+            lo[k] = lo[k].min(q[k]);
+            hi[k] = hi[k].max(q[k]);
+        }
+    }
+    let mut seen: FxHashSet<u32> = FxHashSet::default();
+    let mut near: Vec<u32> = Vec::new();
+    for &v in from {
+        for t in tri.star(v) {
+            if seen.insert(t) {
+                near.push(t);
+            }
+        }
+    }
+    let mut i = 0;
+    while i < near.len() {
+        let t = near[i];
+        i += 1;
+        for k in 0..4 {
+            let nb = tri.neighbour(t, k);
+            if nb == NONE || seen.contains(&(nb >> 2)) {
+                continue;
+            }
+            let u = nb >> 2;
+            let tp = tri.tet_points(u);
+            let meets = (0..3)
+                .all(|d| tp.iter().any(|q| q[d] >= lo[d]) && tp.iter().any(|q| q[d] <= hi[d]))
+                && keep(&tp);
+            seen.insert(u);
+            if meets {
+                near.push(u);
+            }
+        }
+    }
+    near
+}
+
 /// One flip out of the way: the first of the blocking `edges` that can be
 /// removed, else the first of the pierced `faces` (slots) that can be
 /// flipped 2-3, each nested to `depth` levels; whether one was.
@@ -277,45 +294,9 @@ fn flip_one(
 /// `f`.
 pub(crate) fn crossings(tri: &Triangulation, f: [u32; 3]) -> (Vec<(u32, u32)>, Vec<u32>) {
     let p = f.map(|v| tri.pts[v as usize]);
-    let mut lo = p[0];
-    let mut hi = p[0];
-    for q in &p[1..] {
-        for k in 0..3 {
-            lo[k] = lo[k].min(q[k]);
-            hi[k] = hi[k].max(q[k]);
-        }
-    }
     // A point off the face's plane, to order points within it.
     let off = add(p[0], cross(sub(p[1], p[0]), sub(p[2], p[0])));
-    // Tets whose box meets the face's box, grown from its corners' stars.
-    let mut seen: FxHashSet<u32> = FxHashSet::default();
-    let mut near: Vec<u32> = Vec::new();
-    for &v in &f {
-        for t in tri.star(v) {
-            if seen.insert(t) {
-                near.push(t);
-            }
-        }
-    }
-    let mut i = 0;
-    while i < near.len() {
-        let t = near[i];
-        i += 1;
-        for k in 0..4 {
-            let nb = tri.neighbour(t, k);
-            if nb == NONE || seen.contains(&(nb >> 2)) {
-                continue;
-            }
-            let u = nb >> 2;
-            let tp = tri.tet_points(u);
-            let meets = (0..3)
-                .all(|d| tp.iter().any(|q| q[d] >= lo[d]) && tp.iter().any(|q| q[d] <= hi[d]));
-            seen.insert(u);
-            if meets {
-                near.push(u);
-            }
-        }
-    }
+    let near = tets_near(tri, &f, &p, |_| true);
     let mut edges: Vec<(u32, u32)> = Vec::new();
     let mut eseen: FxHashSet<(u32, u32)> = FxHashSet::default();
     let mut faces: Vec<u32> = Vec::new();
