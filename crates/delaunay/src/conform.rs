@@ -16,7 +16,7 @@
 //! ends both.
 use crate::flips::key3;
 use crate::recover::{crossings, recover_all};
-use crate::tri::{Triangulation, TET_FACES};
+use crate::tri::{Triangulation, NONE, TET_FACES};
 use parafront_geom::{add, dist, orient2d, orient3d, scale, tri_normal, P3};
 use rustc_hash::{FxHashMap, FxHashSet};
 
@@ -53,7 +53,7 @@ pub(crate) fn conform_fill(
         // The triangulation's own pieces where they tile a face.
         for i in 0..faces.len() {
             if c.pieces[i].len() > 1 {
-                if let Some(t) = dt_tiling(&tri, &c, i) {
+                if let Some(t) = tiling(&tri, &c, i, false) {
                     c.pieces[i] = t;
                 }
             }
@@ -300,27 +300,51 @@ fn mid(pts: &[P3], u: u32, v: u32) -> P3 {
 
 /// The triangulation's own triangles on face `i`'s points, when they
 /// tile it: as many as its pieces, none on one cavity edge, their areas
-/// adding up to the face's. Oriented as the face.
-pub(crate) fn dt_tiling(tri: &Triangulation, c: &Conforming, i: usize) -> Option<Vec<[u32; 3]>> {
+/// adding up to the face's. Oriented as the face. With `outer`, seen from
+/// outside the cavity: split points lie off the face's plane by rounding,
+/// so the triangulation may hold flat tets on a face's points, and of such
+/// a layer the outer faces are taken (the flat tets are then inside, and go
+/// when the split points move off the surface).
+pub(crate) fn tiling(
+    tri: &Triangulation,
+    c: &Conforming,
+    i: usize,
+    outer: bool,
+) -> Option<Vec<[u32; 3]>> {
     let set: FxHashSet<u32> = c.pieces[i].iter().flatten().map(|&v| v + 4).collect();
     let n = tri_normal_of(&c.pts, c.faces[i]);
+    let flat = |t: u32| tri.tet(t).iter().all(|v| set.contains(v));
     let mut seen: FxHashSet<[u32; 3]> = FxHashSet::default();
     let mut out = Vec::new();
     let mut area = 0.0;
     for &v in &set {
         for t in tri.star(v) {
             let tv = tri.tet(t);
-            for fv in TET_FACES {
+            for (k, fv) in TET_FACES.iter().enumerate() {
                 let w = fv.map(|j| tv[j]);
                 if !w.iter().all(|x| set.contains(x)) || !seen.insert(key3(w)) {
                     continue;
                 }
                 let w = w.map(|x| x - 4);
+                let d = parafront_geom::dot(tri_normal_of(&c.pts, w), n);
+                if outer {
+                    // Face k of t points away from t.
+                    let beyond = if d > 0.0 {
+                        t
+                    } else {
+                        let nb = tri.neighbour(t, k);
+                        if nb == NONE {
+                            return None;
+                        }
+                        nb >> 2
+                    };
+                    if flat(beyond) {
+                        continue;
+                    }
+                }
                 if one_chain(&c.chains, w) {
                     return None;
                 }
-                let m = tri_normal_of(&c.pts, w);
-                let d = parafront_geom::dot(m, n);
                 area += d.abs();
                 out.push(if d > 0.0 { w } else { [w[0], w[2], w[1]] });
             }

@@ -288,7 +288,6 @@ fn validate(points: &[P3], faces: &[[u32; 3]]) -> Result<(), FillError> {
     if faces.is_empty() {
         return Err(FillError::Empty);
     }
-    let mut half: FxHashMap<(u32, u32), i32> = FxHashMap::default();
     for (i, f) in faces.iter().enumerate() {
         if let Some(&v) = f.iter().find(|&&v| v as usize >= points.len()) {
             return Err(FillError::BadIndex(i, v));
@@ -296,17 +295,9 @@ fn validate(points: &[P3], faces: &[[u32; 3]]) -> Result<(), FillError> {
         if f[0] == f[1] || f[1] == f[2] || f[0] == f[2] {
             return Err(FillError::Degenerate(i));
         }
-        for k in 0..3 {
-            let (a, b) = (f[k], f[(k + 1) % 3]);
-            *half.entry((a, b)).or_default() += 1;
-        }
     }
-    // A pinched cavity (two parts touching along an edge) uses the edge
-    // twice each way.
-    for (&(a, b), &n) in &half {
-        if half.get(&(b, a)) != Some(&n) {
-            return Err(FillError::NotClosed(a.min(b), a.max(b)));
-        }
+    if let Some((a, b)) = open_edge(faces) {
+        return Err(FillError::NotClosed(a, b));
     }
     let o = points[faces[0][0] as usize];
     let vol: f64 = faces
@@ -320,6 +311,22 @@ fn validate(points: &[P3], faces: &[[u32; 3]]) -> Result<(), FillError> {
         return Err(FillError::NotPositive);
     }
     Ok(())
+}
+
+/// An edge of `faces` used more often one way than the other (lower id
+/// first), or `None` when the surface is closed. A pinched cavity (two
+/// parts touching along an edge) uses the edge twice each way.
+pub(crate) fn open_edge(faces: &[[u32; 3]]) -> Option<(u32, u32)> {
+    let mut half: FxHashMap<(u32, u32), i32> = FxHashMap::default();
+    for f in faces {
+        for k in 0..3 {
+            let (a, b) = (f[k], f[(k + 1) % 3]);
+            *half.entry((a, b)).or_default() += 1;
+        }
+    }
+    half.iter()
+        .find(|&(&(a, b), &n)| half.get(&(b, a)) != Some(&n))
+        .map(|(&(a, b), _)| (a.min(b), a.max(b)))
 }
 
 /// The tets inside the recovered faces, grown from each face's inner side

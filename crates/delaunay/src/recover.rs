@@ -82,17 +82,9 @@ pub(crate) fn recover_edge(
     flips: &mut usize,
     depth: u32,
 ) -> bool {
-    for _ in 0..budget {
-        if tri.has_edge(a, b) {
-            return true;
-        }
-        let (edges, faces) = segment_crossings(tri, a, b);
-        if !flip_one(tri, &edges, &faces, protect, depth) {
-            return false;
-        }
-        *flips += 1;
-    }
-    tri.has_edge(a, b)
+    let present = |t: &Triangulation| t.has_edge(a, b);
+    let blockers = |t: &Triangulation| segment_crossings(t, a, b);
+    flip_until(tri, present, blockers, protect, budget, flips, depth)
 }
 
 /// The edges segment `a`-`b` passes through (their interiors) and the
@@ -198,17 +190,33 @@ fn recover_face(
     flips: &mut usize,
     depth: u32,
 ) -> bool {
+    let present = |t: &Triangulation| t.find_face(f).is_some();
+    let blockers = |t: &Triangulation| crossings(t, f);
+    flip_until(tri, present, blockers, protect, budget, flips, depth)
+}
+
+/// Flip what `blockers` finds in the way, one flip at a time ([`flip_one`])
+/// and at most `budget`, until `present` holds; whether it does.
+fn flip_until(
+    tri: &mut Triangulation,
+    present: impl Fn(&Triangulation) -> bool,
+    blockers: impl Fn(&Triangulation) -> (Vec<(u32, u32)>, Vec<u32>),
+    protect: &FxHashSet<[u32; 3]>,
+    budget: usize,
+    flips: &mut usize,
+    depth: u32,
+) -> bool {
     for _ in 0..budget {
-        if tri.find_face(f).is_some() {
+        if present(tri) {
             return true;
         }
-        let (edges, faces) = crossings(tri, f);
+        let (edges, faces) = blockers(tri);
         if !flip_one(tri, &edges, &faces, protect, depth) {
             return false;
         }
         *flips += 1;
     }
-    tri.find_face(f).is_some()
+    present(tri)
 }
 
 /// The tets around the points `from` and those reached from them, across

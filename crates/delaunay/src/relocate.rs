@@ -7,6 +7,7 @@
 //! it when no tiling does. Each hole's fill is checked against it, and the
 //! whole at the end.
 use crate::conform::{ear_clip_preferring, polygon_fans, tri_normal_of, Chains};
+use crate::fill::open_edge;
 use crate::flips::key3;
 use crate::predicates::is_flat;
 use crate::tri::TET_FACES;
@@ -88,18 +89,6 @@ fn fills(pts: &[P3], extra: &[P3], tets: &[[u32; 4]], hole: &[[u32; 3]], how: &s
         );
     }
     ok
-}
-
-/// Every directed edge of `hole` is matched by its reverse, once.
-fn closed(hole: &[[u32; 3]]) -> bool {
-    let mut half: FxHashMap<(u32, u32), i32> = FxHashMap::default();
-    for w in hole {
-        for k in 0..3 {
-            let (a, b) = (w[k], w[(k + 1) % 3]);
-            *half.entry((a.min(b), a.max(b))).or_default() += if a < b { 1 } else { -1 };
-        }
-    }
-    half.values().all(|&c| c == 0)
 }
 
 /// Drop each pair of faces that are one triangle seen from both sides
@@ -243,7 +232,7 @@ fn relocate_one(
             let mut hole = link_faces.clone();
             hole.extend(patch.iter().map(|(p, _)| *p));
             cancel_opposite(&mut hole);
-            if !closed(&hole) {
+            if open_edge(&hole).is_some() {
                 tracing::debug!(hole = hole.len(), point = s, "conform: hole not closed");
                 continue;
             }

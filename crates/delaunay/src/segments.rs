@@ -6,14 +6,14 @@
 //! the surface into the cavity (`conform::relocate`). Rebuilding the
 //! triangulation after each round of splits instead (`conform_fill`) loses
 //! what the flips had recovered, and on thin cracks does not converge.
-use crate::conform::{one_chain, split_point, Conforming};
+use crate::conform::{split_point, tiling, Conforming};
 use crate::fill::classify;
 use crate::flips::{edge_key, key3};
 use crate::predicates::is_flat;
 use crate::recover::{recover_edge, recover_faces, DEPTH};
 use crate::relocate::relocate;
-use crate::tri::{Triangulation, NONE, TET_FACES};
-use parafront_geom::{dot, tri_normal, P3};
+use crate::tri::{Triangulation, NONE};
+use parafront_geom::P3;
 use rustc_hash::FxHashSet;
 
 /// Rounds of flat-tet removal before relocation.
@@ -38,22 +38,15 @@ pub(crate) fn conform_kept(
     for _ in 0..ROUNDS {
         // What is there to keep: the edges' pieces and the faces' pieces
         // the triangulation has.
-        let mut protect: FxHashSet<[u32; 3]> = FxHashSet::default();
-        for ch in c.chains.values() {
-            for w in ch.windows(2) {
-                if tri.has_edge(w[0] + 4, w[1] + 4) {
-                    protect.insert(edge_key(w[0] + 4, w[1] + 4));
+        let mut protect: FxHashSet<[u32; 3]> = piece_keys(&c)
+            .filter(|&k| {
+                if k[2] == NONE {
+                    tri.has_edge(k[0], k[1])
+                } else {
+                    tri.find_face(k).is_some()
                 }
-            }
-        }
-        for ps in &c.pieces {
-            for p in ps {
-                let w = p.map(|v| v + 4);
-                if tri.find_face(w).is_some() {
-                    protect.insert(key3(w));
-                }
-            }
-        }
+            })
+            .collect();
         // Edges first.
         loop {
             let mut pieces: Vec<(u32, u32)> = c
@@ -66,7 +59,6 @@ pub(crate) fn conform_kept(
             for (u, v) in pieces {
                 let (a, b) = (u + 4, v + 4);
                 if protect.contains(&edge_key(a, b))
-                    || tri.has_edge(a, b)
                     || recover_edge(&mut tri, a, b, &protect, per_face, &mut flips, DEPTH)
                 {
                     protect.insert(edge_key(a, b));
@@ -96,7 +88,7 @@ pub(crate) fn conform_kept(
         // Then the faces, as the triangulation tiles them where it does.
         for i in 0..faces.len() {
             if c.pieces[i].len() > 1 {
-                if let Some(t) = outer_tiling(&tri, &c, i) {
+                if let Some(t) = tiling(&tri, &c, i, true) {
                     c.pieces[i] = t;
                 }
             }
@@ -111,18 +103,16 @@ pub(crate) fn conform_kept(
             "conform_kept: pieces"
         );
         if still.is_empty() {
-            let kept = classify(&tri, &tf)?;
             // A flip that fails can still have changed tets: classify
-            // again. A flip can leave a flat tet beside (a strip of
-            // coplanar needles): a few rounds.
-            let mut kept = kept;
+            // again after any was tried. A flip can leave a flat tet
+            // beside (a strip of coplanar needles): a few rounds.
+            let mut kept = classify(&tri, &tf)?;
             for _ in 0..UNFLATTEN_ROUNDS {
                 if !unflatten(&mut tri, &kept, &protect) {
                     break;
                 }
                 kept = classify(&tri, &tf)?;
             }
-            let kept = classify(&tri, &tf)?;
             let tets: Vec<[u32; 4]> = kept.iter().map(|&t| tri.tet(t).map(|v| v - 4)).collect();
             return relocate(n0, c.pts, &c.chains, tets, sub, origin, faces);
         }
@@ -137,17 +127,7 @@ pub(crate) fn conform_kept(
             return None;
         }
         // Pieces split above are not kept any more.
-        let mut keep: FxHashSet<[u32; 3]> = FxHashSet::default();
-        for ch in c.chains.values() {
-            for w in ch.windows(2) {
-                keep.insert(edge_key(w[0] + 4, w[1] + 4));
-            }
-        }
-        for ps in &c.pieces {
-            for p in ps {
-                keep.insert(key3(p.map(|v| v + 4)));
-            }
-        }
+        let keep: FxHashSet<[u32; 3]> = piece_keys(&c).collect();
         protect.retain(|k| keep.contains(k));
         for k in before..c.pts.len() {
             let id = tri.insert_constrained(c.pts[k], &protect)?;
@@ -157,54 +137,15 @@ pub(crate) fn conform_kept(
     None
 }
 
-/// The triangulation's own triangles on face `i`'s points, when they tile
-/// it, seen from outside the cavity: split points lie off the face's plane
-/// by rounding, so the triangulation may hold flat tets on a face's points,
-/// and of such a layer the outer faces are taken. The flat tets are then
-/// inside, and go when the split points move off the surface.
-fn outer_tiling(tri: &Triangulation, c: &Conforming, i: usize) -> Option<Vec<[u32; 3]>> {
-    let set: FxHashSet<u32> = c.pieces[i].iter().flatten().map(|&v| v + 4).collect();
-    let pt = |v: u32| tri.points()[v as usize];
-    let f = c.faces[i].map(|v| v + 4);
-    let n = tri_normal(pt(f[0]), pt(f[1]), pt(f[2]));
-    let flat = |t: u32| tri.tet(t).iter().all(|v| set.contains(v));
-    let mut seen: FxHashSet<[u32; 3]> = FxHashSet::default();
-    let mut out = Vec::new();
-    let mut area = 0.0;
-    for &v in &set {
-        for t in tri.star(v) {
-            let tv = tri.tet(t);
-            for (k, fv) in TET_FACES.iter().enumerate() {
-                let w = fv.map(|j| tv[j]);
-                if !w.iter().all(|x| set.contains(x)) || !seen.insert(key3(w)) {
-                    continue;
-                }
-                // Face k of t points away from t.
-                let d = dot(tri_normal(pt(w[0]), pt(w[1]), pt(w[2])), n);
-                let outer = if d > 0.0 {
-                    t
-                } else {
-                    let nb = tri.neighbour(t, k);
-                    if nb == NONE {
-                        return None;
-                    }
-                    nb >> 2
-                };
-                if flat(outer) {
-                    continue;
-                }
-                let w = w.map(|x| x - 4);
-                if one_chain(&c.chains, w) {
-                    return None;
-                }
-                area += d.abs();
-                out.push(if d > 0.0 { w } else { [w[0], w[2], w[1]] });
-            }
-        }
-    }
-    out.sort_unstable();
-    let whole = dot(n, n);
-    (out.len() == c.pieces[i].len() && (area - whole).abs() <= 1e-9 * whole).then_some(out)
+/// The surface's pieces as they stand, in triangulation ids: each edge
+/// piece as its [`edge_key`], each face piece as its [`key3`].
+fn piece_keys(c: &Conforming) -> impl Iterator<Item = [u32; 3]> + '_ {
+    let edges = c
+        .chains
+        .values()
+        .flat_map(|ch| ch.windows(2).map(|w| edge_key(w[0] + 4, w[1] + 4)));
+    let faces = c.pieces.iter().flatten().map(|p| key3(p.map(|v| v + 4)));
+    edges.chain(faces)
 }
 
 /// Remove the flat tets among `kept` by edge removal where the edges
