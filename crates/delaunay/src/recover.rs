@@ -176,6 +176,41 @@ fn segment_near_tet(a: P3, b: P3, tp: &[P3; 4]) -> bool {
     true
 }
 
+/// Triangle `p` comes within rounding of tet `tp`: no corner of the
+/// tet is on the inner side of the triangle's plane (or of the plane
+/// through one of its edges, square to it) and all of them are beyond it,
+/// each plane moved out by a relative tolerance. A float filter that keeps
+/// every tet the triangle meets (the tets around a face of a thin crack,
+/// whose box meets it, were most of its recovery's time).
+fn triangle_near_tet(p: [P3; 3], tp: &[P3; 4]) -> bool {
+    let n = cross(sub(p[1], p[0]), sub(p[2], p[0]));
+    let l1 = |x: P3| x[0].abs() + x[1].abs() + x[2].abs();
+    let mut size = 0.0f64;
+    for q in tp {
+        size = size.max(l1(sub(*q, p[0])));
+    }
+    for q in &p[1..] {
+        size = size.max(l1(sub(*q, p[0])));
+    }
+    // Outside one plane (through `a`, normal `m`) with every corner.
+    let beyond = |a: P3, m: P3, sign: f64| {
+        let tol = 1e-9 * l1(m) * size;
+        tp.iter()
+            .all(|q| sign * parafront_geom::dot(m, sub(*q, a)) > tol)
+    };
+    if beyond(p[0], n, 1.0) || beyond(p[0], n, -1.0) {
+        return false;
+    }
+    for e in 0..3 {
+        let (a, b) = (p[e], p[(e + 1) % 3]);
+        // Outward from the triangle, in its plane.
+        if beyond(a, cross(sub(b, a), n), 1.0) {
+            return false;
+        }
+    }
+    true
+}
+
 /// Levels of nested flips (`flip23_deep`). On the thin cracks the front
 /// leaves on CAD parts (six cavities of 144-296 faces), plain flips left
 /// 20-144 faces missing, two levels 12-77, three 0-66 at several times the
@@ -304,7 +339,7 @@ pub(crate) fn crossings(tri: &Triangulation, f: [u32; 3]) -> (Vec<(u32, u32)>, V
     let p = f.map(|v| tri.pts[v as usize]);
     // A point off the face's plane, to order points within it.
     let off = add(p[0], cross(sub(p[1], p[0]), sub(p[2], p[0])));
-    let near = tets_near(tri, &f, &p, |_| true);
+    let near = tets_near(tri, &f, &p, |tp| triangle_near_tet(p, tp));
     let mut edges: Vec<(u32, u32)> = Vec::new();
     let mut eseen: FxHashSet<(u32, u32)> = FxHashSet::default();
     let mut faces: Vec<u32> = Vec::new();

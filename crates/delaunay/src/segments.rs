@@ -20,6 +20,9 @@ use rustc_hash::FxHashSet;
 const UNFLATTEN_ROUNDS: usize = 4;
 /// Rounds of face recovery and splits before it gives up.
 const ROUNDS: usize = 24;
+/// Rounds of piece splits without fewer pieces missing before the fill
+/// gives up.
+const STALLED_ROUNDS: u32 = 3;
 
 /// The cavity's points (`lp`, each face's corners index it) and faces; a
 /// fill as Steiner points and tets over `lp` then the Steiner points, or
@@ -35,6 +38,8 @@ pub(crate) fn conform_kept(
     // Ids in the triangulation are 4 + ids in `c.pts`.
     let mut tri = Triangulation::new(lp).ok()?;
     let mut flips = 0;
+    let mut fewest = usize::MAX;
+    let mut stalled = 0;
     for _ in 0..ROUNDS {
         // What is there to keep: the edges' pieces and the faces' pieces
         // the triangulation has.
@@ -115,6 +120,19 @@ pub(crate) fn conform_kept(
             }
             let tets: Vec<[u32; 4]> = kept.iter().map(|&t| tri.tet(t).map(|v| v - 4)).collect();
             return relocate(n0, c.pts, &c.chains, tets, sub, origin, faces);
+        }
+        // Splitting pieces that has not shrunk the missing set for a few
+        // rounds is diverging (a thin crack's pieces: 78, 50, 54, 71, ...
+        // missing while the splits went past 400; the whole plate's went
+        // 33, 17, 17, ... to 0).
+        if still.len() < fewest {
+            fewest = still.len();
+            stalled = 0;
+        } else {
+            stalled += 1;
+            if stalled >= STALLED_ROUNDS {
+                return None;
+            }
         }
         let before = c.pts.len();
         for m in still {

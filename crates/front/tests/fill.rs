@@ -223,3 +223,53 @@ fn a_smooth_sphere_has_few_slivers_before_improvement() {
     assert!(m.tets.len() > 10_000, "{} tets", m.tets.len());
     assert!(share < 0.01, "{:.2} % of tets under 10 deg", 100.0 * share);
 }
+
+/// The hinge (a CAD part of needle triangles, 1,212 faces) under its own
+/// edge lengths: the front stalls on most of its faces at once. The fill
+/// at that first stall closes every cavity, so no recovery round runs;
+/// without it, recovery takes rounds. Both meshes are valid.
+#[test]
+fn a_first_stall_on_most_faces_is_filled_without_recovery() {
+    use parafront_surface::read::{read_surface_bytes, Format};
+    let text = include_str!("../../delaunay/tests/data/hinge_surface.obj");
+    // Its faces point inward, as the front takes them.
+    let s = read_surface_bytes("hinge.obj", text.as_bytes(), Format::Obj).expect("OBJ");
+    let tris: Vec<[u32; 3]> = s.tris.iter().map(|t| [t[0], t[2], t[1]]).collect();
+    let mut stats = Vec::new();
+    for fill_at_stall in [true, false] {
+        let input = FrontInput {
+            points: s.points.clone(),
+            point_size: s.mean_edge_lengths(),
+            faces: s.tris.clone(),
+        };
+        let field = |_p: P3| 5.0;
+        let r = advance(
+            input,
+            SizeMode::Field(&field),
+            &Everywhere,
+            &FrontOptions {
+                fill_at_stall,
+                ..FrontOptions::default()
+            },
+        )
+        .expect("front closes");
+        assert!(r.front.is_empty());
+        let m = TetMesh {
+            points: r.points,
+            tets: r.tets.iter().map(|t| t.map(PointId::from_raw)).collect(),
+            region: vec![0; r.tets.len()],
+            ..Default::default()
+        };
+        m.check_against_surface(&tris)
+            .unwrap_or_else(|e| panic!("invalid mesh (fill at stall {fill_at_stall}): {e}"));
+        eprintln!(
+            "fill at stall {fill_at_stall}: {} tets, {:?}",
+            m.tets.len(),
+            r.stats
+        );
+        stats.push(r.stats);
+    }
+    assert_eq!(stats[0].recovery_rounds, 0, "{:?}", stats[0]);
+    assert!(stats[0].cavities_filled > 0, "{:?}", stats[0]);
+    assert!(stats[1].recovery_rounds > 0, "{:?}", stats[1]);
+}

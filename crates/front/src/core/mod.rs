@@ -73,6 +73,14 @@ pub const DEFAULT_FILL_AFTER: u32 = 4;
 /// gave up after 4.0 s, with one after 3.5 s (one sitting).
 const FILL_TRIES: u32 = 1;
 
+/// A front whose first stall leaves at least this share of its input
+/// faces' count stuck fills its cavities before any recovery round
+/// (`FrontOptions::fill_at_stall`). The CAD parts of the corpus stall on
+/// 68-139 % (tray, plate, hinge), the smooth ones and the bench surfaces
+/// on 1-6 %, where a recovery round closes the few stuck faces in
+/// milliseconds and the fill's tets are not the front's.
+const STALL_FILL_SHARE: f64 = 0.25;
+
 /// A front that stalls for the first time with fewer tets than this many
 /// per input face hands its whole region to the fill
 /// ([`Front::fill_early`]): round.stl stalls at 76 tets for 1,120 faces,
@@ -133,6 +141,11 @@ pub struct FrontOptions {
     /// (edges split first); where that fails, recovery goes on. For a
     /// region's surface; a gap left by the passes (§7) is thin by nature.
     pub fill_early: bool,
+    /// At the front's first stall, when it leaves many faces stuck, fill
+    /// the cavities (no growth rounds) before any recovery round; those
+    /// the fill cannot close go on to recovery. Not in a parallel pass
+    /// (§7), whose front is open.
+    pub fill_at_stall: bool,
 }
 
 impl Default for FrontOptions {
@@ -150,6 +163,7 @@ impl Default for FrontOptions {
             fill_growth: 4,
             fill_after: DEFAULT_FILL_AFTER,
             fill_early: false,
+            fill_at_stall: true,
         }
     }
 }
@@ -377,6 +391,8 @@ struct Front<'a> {
     /// The input front, kept while the first stall may still hand it
     /// whole to the fill ([`EARLY_FILL_TETS`]).
     input0: Vec<[u32; 3]>,
+    /// Faces of the input front.
+    n_input_faces: usize,
     opts: &'a FrontOptions,
     region: &'a dyn RegionFilter,
     size: SizeMode<'a>,
@@ -518,6 +534,7 @@ impl<'a> Front<'a> {
             new_at: Vec::new(),
             relax: 0,
             input0: Vec::new(),
+            n_input_faces: input.faces.len(),
             opts,
             region,
             size,
@@ -678,7 +695,7 @@ impl<'a> Front<'a> {
                 && self.relax >= self.opts.fill_after
                 && self.relax.is_multiple_of(self.opts.fill_after);
             if self.opts.fill && (give_up || due) {
-                let filled = self.fill_stalled(self.opts.fill_growth);
+                let filled = self.fill_stalled(self.opts.fill_growth, false);
                 debug_assert_eq!(self.check(), Ok(()), "after a fill");
                 if filled {
                     continue;
@@ -692,6 +709,20 @@ impl<'a> Front<'a> {
             // input face (a surface of needles under a size that no tet on
             // them can meet) hands the whole region to the fill.
             if self.relax == 0 && !self.input0.is_empty() && self.fill_early() {
+                continue;
+            }
+            // A first stall on much of the surface (CAD parts, whose long
+            // faces leave thin cracks): the cavities the fill closes at
+            // once need no recovery round (each cost as much as the front
+            // before it); the others go on to recovery, and their failure
+            // here does not count.
+            if self.relax == 0
+                && self.opts.fill
+                && self.opts.fill_at_stall
+                && !self.opts.pass
+                && self.stuck.len() as f64 >= STALL_FILL_SHARE * self.n_input_faces as f64
+                && self.fill_stalled(0, true)
+            {
                 continue;
             }
             self.input0 = Vec::new();
