@@ -1,5 +1,5 @@
 //! Fill the cavity in an OBJ file (faces pointing into it) and report:
-//! `cargo run --example fill_obj -- CAVITY.obj [MAX_STEINER MAX_STEINER_FACES MAX_SEARCH_FACES [MAX_SPLIT]]`.
+//! `cargo run --example fill_obj -- CAVITY.obj [MAX_STEINER MAX_STEINER_FACES MAX_SEARCH_FACES [MAX_SPLIT [HEADWAY_ROUNDS]]]`.
 use parafront_delaunay::{fill_cavity, FillOptions};
 use std::time::Instant;
 
@@ -51,6 +51,10 @@ fn main() {
     if let Some(n) = arg(5) {
         opts.segments_first = true;
         opts.max_split = n;
+    }
+    // A sixth, R: it gives up after R rounds of splits without headway.
+    if let Some(n) = arg(6) {
+        opts.headway_rounds = n as u32;
     }
     match fill_cavity(&pts, &faces, &opts) {
         Ok(f) => {

@@ -55,6 +55,14 @@ pub struct FillOptions {
     /// moved inside. For a whole region (a front that stalls on most of its
     /// faces at once, or cannot close it). Off by default.
     pub segments_first: bool,
+    /// With `segments_first`: rounds of splits that leave more edges, or
+    /// more face pieces, missing than the fewest so far before the fill
+    /// gives up as diverging; 0 (default): never, the split budget bounds
+    /// it. For the front's cavities, where a failure has a next step
+    /// (recovery, growth); a region's last resort has none (the whole
+    /// plate at size 7.5 went 59, 50, 61, 71, 60, ... edges missing and
+    /// closed).
+    pub headway_rounds: u32,
 }
 
 impl Default for FillOptions {
@@ -70,6 +78,7 @@ impl Default for FillOptions {
             max_split: 4096,
             max_conform_missing: 20,
             segments_first: false,
+            headway_rounds: 0,
         }
     }
 }
@@ -455,7 +464,13 @@ fn conform(points: &[P3], faces: &[[u32; 3]], local: &[u32], opts: &FillOptions)
         // that flips do not undo), edges split until Delaunay and the
         // triangulation rebuilt (round.stl's 1,120 needles: 1,574 tets with
         // one flat, against 4,464 with none).
-        let kept = crate::segments::conform_kept(lp, lf, max_split, opts.flips_per_face);
+        let kept = crate::segments::conform_kept(
+            lp,
+            lf,
+            max_split,
+            opts.flips_per_face,
+            opts.headway_rounds,
+        );
         let flat = |(st, tets): &(Vec<P3>, Vec<[u32; 4]>)| {
             tets.iter().any(|t| {
                 is_flat(t.map(|v| {

@@ -20,9 +20,38 @@ use rustc_hash::FxHashSet;
 const UNFLATTEN_ROUNDS: usize = 4;
 /// Rounds of face recovery and splits before it gives up.
 const ROUNDS: usize = 24;
-/// Rounds of piece splits without fewer pieces missing before the fill
-/// gives up.
-const STALLED_ROUNDS: u32 = 3;
+/// Whether a fill's rounds of splits still make headway: a fill gives up
+/// after `limit` rounds (0: never) that leave more pieces missing than the
+/// fewest so far, as diverging (a thin crack's face pieces went 78, 50,
+/// 54, 71, ... while the splits passed 400; a first stall's 1,584-face
+/// crack's edges 80, 53, 59, 72, 77, ... for 2 s). Rounds that leave as
+/// many are the slow tail of a fill that closes (the plate's 1,560-face
+/// cavity: 2, 2, 2, 2, 1, 0 edges; the whole plate: 17, 17, 0 faces).
+struct Headway {
+    fewest: usize,
+    worse: u32,
+    limit: u32,
+}
+
+impl Headway {
+    fn new(limit: u32) -> Headway {
+        Headway {
+            fewest: usize::MAX,
+            worse: 0,
+            limit,
+        }
+    }
+
+    /// After a round that left `missing`.
+    fn goes_on(&mut self, missing: usize) -> bool {
+        if missing < self.fewest {
+            self.fewest = missing;
+        } else if missing > self.fewest {
+            self.worse += 1;
+        }
+        self.limit == 0 || self.worse < self.limit
+    }
+}
 
 /// The cavity's points (`lp`, each face's corners index it) and faces; a
 /// fill as Steiner points and tets over `lp` then the Steiner points, or
@@ -32,14 +61,15 @@ pub(crate) fn conform_kept(
     faces: &[[u32; 3]],
     max_split: usize,
     per_face: usize,
+    headway_rounds: u32,
 ) -> Option<(Vec<P3>, Vec<[u32; 4]>)> {
     let n0 = lp.len();
     let mut c = Conforming::new(lp, faces);
     // Ids in the triangulation are 4 + ids in `c.pts`.
     let mut tri = Triangulation::new(lp).ok()?;
     let mut flips = 0;
-    let mut fewest = usize::MAX;
-    let mut stalled = 0;
+    let mut edge_headway = Headway::new(headway_rounds);
+    let mut face_headway = Headway::new(headway_rounds);
     for _ in 0..ROUNDS {
         // What is there to keep: the edges' pieces and the faces' pieces
         // the triangulation has.
@@ -79,6 +109,9 @@ pub(crate) fn conform_kept(
             );
             if missing.is_empty() {
                 break;
+            }
+            if !edge_headway.goes_on(missing.len()) {
+                return None;
             }
             for (u, v) in missing {
                 if c.pts.len() - n0 >= max_split {
@@ -121,18 +154,8 @@ pub(crate) fn conform_kept(
             let tets: Vec<[u32; 4]> = kept.iter().map(|&t| tri.tet(t).map(|v| v - 4)).collect();
             return relocate(n0, c.pts, &c.chains, tets, sub, origin, faces);
         }
-        // Splitting pieces that has not shrunk the missing set for a few
-        // rounds is diverging (a thin crack's pieces: 78, 50, 54, 71, ...
-        // missing while the splits went past 400; the whole plate's went
-        // 33, 17, 17, ... to 0).
-        if still.len() < fewest {
-            fewest = still.len();
-            stalled = 0;
-        } else {
-            stalled += 1;
-            if stalled >= STALLED_ROUNDS {
-                return None;
-            }
+        if !face_headway.goes_on(still.len()) {
+            return None;
         }
         let before = c.pts.len();
         for m in still {
@@ -198,4 +221,27 @@ fn unflatten(tri: &mut Triangulation, kept: &[u32], protect: &FxHashSet<[u32; 3]
         }
     }
     any
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Headway;
+
+    /// Rounds that leave as many missing as the fewest are a closing
+    /// fill's tail; rounds that leave more count, and the limit-th ends
+    /// it; a limit of 0 never does.
+    #[test]
+    fn headway_counts_only_rounds_worse_than_the_best() {
+        let run = |limit: u32, missing: &[usize]| {
+            let mut h = Headway::new(limit);
+            missing.iter().position(|&m| !h.goes_on(m))
+        };
+        // The plate's 1,560-face cavity, which closes.
+        assert_eq!(run(3, &[67, 48, 43, 33, 17, 8, 4, 2, 2, 2, 2, 1]), None);
+        // A first stall's crack that does not.
+        assert_eq!(run(3, &[80, 53, 59, 72, 77, 44, 16]), Some(4));
+        // Worse rounds need not follow each other.
+        assert_eq!(run(3, &[50, 60, 40, 45, 30, 31]), Some(5));
+        assert_eq!(run(0, &[80, 53, 59, 72, 77, 90, 100]), None);
+    }
 }

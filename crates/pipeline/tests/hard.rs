@@ -118,20 +118,26 @@ fn thin_slots_under_a_large_size() {
 
 #[test]
 fn slot_under_ten_times_its_width() {
-    // The front cannot close it, with the lattice (at a largest size) or
-    // without: the region is filled whole, and the mesh is valid. (With a
-    // lattice margin of a whole cell, not the default half, the front
-    // closed it: 12k tets in 2.9 s.)
+    // The front stalls beside the slot on most of its faces at once; the
+    // fill at that first stall and the cavity fills after recovery close
+    // it (before them, the front could not, and the region was filled
+    // whole and refined to the size). Either way the mesh is valid and at
+    // the size.
     let s = slotted_box(1e-2);
     let mut o = MeshOptions::default();
     o.size.h = Some(0.1);
     let (m, sum) = mesh_surface(&s, &o).expect("the slot meshes");
     m.check_against_surface(&s.tris).expect("valid");
-    assert_eq!(sum.regions_filled, vec![1], "the whole-region fill ran");
+    println!(
+        "slot 0.01 at size 0.1: {} tets, regions filled whole {:?}, {} cavities filled",
+        m.tets.len(),
+        sum.regions_filled,
+        sum.cavities_filled
+    );
     let v = s.signed_volume();
     assert!((m.volume() - v).abs() <= 1e-9 * v);
-    // The fill is refined to the size (GDT): a regular tet of edge 0.1 is
-    // 1.2e-4, so about 8,000 of them; the fill alone made 23.
+    // A regular tet of edge 0.1 is 1.2e-4, so about 8,000 of them; the
+    // surface alone closes with 23.
     assert!(m.tets.len() > 3000, "{} tets", m.tets.len());
     let (mut sum_l, mut n) = (0.0, 0);
     for t in &m.tets {
