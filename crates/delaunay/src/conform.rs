@@ -51,13 +51,7 @@ pub(crate) fn conform_fill(
         // round, as flips leave it non-Delaunay.
         let mut tri = Triangulation::new(&c.pts).ok()?;
         // The triangulation's own pieces where they tile a face.
-        for i in 0..faces.len() {
-            if c.pieces[i].len() > 1 {
-                if let Some(t) = tiling(&tri, &c, i, false) {
-                    c.pieces[i] = t;
-                }
-            }
-        }
+        c.retile(&tri, false);
         let (sub, origin) = c.flat();
         let tf: Vec<[u32; 3]> = sub.iter().map(|f| f.map(|v| v + 4)).collect();
         let mut flips = 0;
@@ -153,6 +147,18 @@ impl Conforming {
                 let id = tri.insert(m).ok()?;
                 debug_assert_eq!(id as usize, self.pts.len() + 4);
                 self.split_edge(u, v, m);
+            }
+        }
+    }
+
+    /// Each split face's pieces as `tri` tiles it, where it does
+    /// ([`tiling`], seen from outside with `outer`).
+    pub(crate) fn retile(&mut self, tri: &Triangulation, outer: bool) {
+        for i in 0..self.faces.len() {
+            if self.pieces[i].len() > 1 {
+                if let Some(t) = tiling(tri, self, i, outer) {
+                    self.pieces[i] = t;
+                }
             }
         }
     }

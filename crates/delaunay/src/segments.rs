@@ -6,7 +6,7 @@
 //! the surface into the cavity (`conform::relocate`). Rebuilding the
 //! triangulation after each round of splits instead (`conform_fill`) loses
 //! what the flips had recovered, and on thin cracks does not converge.
-use crate::conform::{split_point, tiling, Conforming};
+use crate::conform::{split_point, Conforming};
 use crate::fill::classify;
 use crate::flips::{edge_key, key3};
 use crate::predicates::is_flat;
@@ -124,13 +124,7 @@ pub(crate) fn conform_kept(
             }
         }
         // Then the faces, as the triangulation tiles them where it does.
-        for i in 0..faces.len() {
-            if c.pieces[i].len() > 1 {
-                if let Some(t) = tiling(&tri, &c, i, true) {
-                    c.pieces[i] = t;
-                }
-            }
-        }
+        c.retile(&tri, true);
         let (sub, origin) = c.flat();
         let tf: Vec<[u32; 3]> = sub.iter().map(|f| f.map(|v| v + 4)).collect();
         let still = recover_faces(&mut tri, &tf, &mut protect, per_face, &mut flips, DEPTH);

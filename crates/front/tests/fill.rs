@@ -5,19 +5,18 @@ use parafront_mesh::{PointId, TetMesh};
 use parafront_surface::{generate, Surface};
 
 fn fill(s: &Surface, h: f64) -> (TetMesh, FrontStats) {
+    fill_with(s, h, &FrontOptions::default())
+}
+
+/// [`fill`] under `opts`.
+fn fill_with(s: &Surface, h: f64, opts: &FrontOptions) -> (TetMesh, FrontStats) {
     let input = FrontInput {
         points: s.points.clone(),
         point_size: s.mean_edge_lengths(),
         faces: s.tris.iter().map(|t| [t[0], t[2], t[1]]).collect(),
     };
     let field = move |_p: P3| h;
-    let r = advance(
-        input,
-        SizeMode::Field(&field),
-        &Everywhere,
-        &FrontOptions::default(),
-    )
-    .expect("front closes");
+    let r = advance(input, SizeMode::Field(&field), &Everywhere, opts).expect("front closes");
     assert!(r.front.is_empty());
     let mut m = TetMesh {
         points: r.points,
@@ -233,42 +232,24 @@ fn a_first_stall_on_most_faces_is_filled_without_recovery() {
     use parafront_surface::read::{read_surface_bytes, Format};
     let text = include_str!("../../delaunay/tests/data/hinge_surface.obj");
     // Its faces point inward, as the front takes them.
-    let s = read_surface_bytes("hinge.obj", text.as_bytes(), Format::Obj).expect("OBJ");
-    let tris: Vec<[u32; 3]> = s.tris.iter().map(|t| [t[0], t[2], t[1]]).collect();
-    let mut stats = Vec::new();
-    for fill_at_stall in [true, false] {
-        let input = FrontInput {
-            points: s.points.clone(),
-            point_size: s.mean_edge_lengths(),
-            faces: s.tris.clone(),
-        };
-        let field = |_p: P3| 5.0;
-        let r = advance(
-            input,
-            SizeMode::Field(&field),
-            &Everywhere,
-            &FrontOptions {
+    let s = read_surface_bytes("hinge.obj", text.as_bytes(), Format::Obj)
+        .expect("OBJ")
+        .flipped();
+    let stats: Vec<FrontStats> = [true, false]
+        .into_iter()
+        .map(|fill_at_stall| {
+            let opts = FrontOptions {
                 fill_at_stall,
                 ..FrontOptions::default()
-            },
-        )
-        .expect("front closes");
-        assert!(r.front.is_empty());
-        let m = TetMesh {
-            points: r.points,
-            tets: r.tets.iter().map(|t| t.map(PointId::from_raw)).collect(),
-            region: vec![0; r.tets.len()],
-            ..Default::default()
-        };
-        m.check_against_surface(&tris)
-            .unwrap_or_else(|e| panic!("invalid mesh (fill at stall {fill_at_stall}): {e}"));
-        eprintln!(
-            "fill at stall {fill_at_stall}: {} tets, {:?}",
-            m.tets.len(),
-            r.stats
-        );
-        stats.push(r.stats);
-    }
+            };
+            let (m, st) = fill_with(&s, 5.0, &opts);
+            eprintln!(
+                "fill at stall {fill_at_stall}: {} tets, {st:?}",
+                m.tets.len()
+            );
+            st
+        })
+        .collect();
     assert_eq!(stats[0].recovery_rounds, 0, "{:?}", stats[0]);
     assert!(stats[0].cavities_filled > 0, "{:?}", stats[0]);
     assert!(stats[1].recovery_rounds > 0, "{:?}", stats[1]);

@@ -22,8 +22,9 @@ const HEADWAY_ROUNDS: u32 = 3;
 /// front's cracks that no fill closes fail in 0.2-0.5 s at 128.
 const MIN_SPLITS: usize = 128;
 
-/// One cavity's fill: in TetGen's order (edges, then faces, then the split
-/// points moved inside), with a bounded number of splits; unless `quick`,
+/// One cavity's fill: the conforming fill, in TetGen's order (edges, then
+/// faces, then the split points moved inside; where that fails, edges
+/// split until Delaunay), with a bounded number of splits; unless `quick`,
 /// then by the Delaunay fill's flips, cone and search. The first closed
 /// more of the corpus's first-stall cavities, the second some cracks of
 /// later rounds; on a first stall's large cavity (400 faces) it fails in
@@ -48,7 +49,7 @@ fn fill_one(
 
 impl<'a> Front<'a> {
     /// Fill every cavity of the live front; `false` when one is left after
-    /// `growth` growth rounds. `quick`: only the fill in TetGen's order.
+    /// `growth` growth rounds. `quick`: only the conforming fill.
     pub(super) fn fill_stalled(&mut self, growth: u32, quick: bool) -> bool {
         for round in 0..=growth {
             let comps = self.live_components();
