@@ -144,9 +144,15 @@ struct MeshArgs {
     /// of their own; without it every inner shell is a void.
     #[arg(long)]
     regions: bool,
-    /// Parts of the parallel mesher (the paper's nproc; 1: serial front).
-    #[arg(long, default_value_t = 1)]
+    /// Parts of the parallel mesher (the paper's nproc): auto (one per
+    /// --part-tets estimated tets, the serial front under two; chosen
+    /// from the job, never from the threads, so the mesh does not depend
+    /// on them), 1 (the serial front) or more
+    #[arg(long, value_name = "auto|N", default_value = "auto", value_parser = parse_parts)]
     parts: usize,
+    /// With --parts auto: one part per this many estimated tets
+    #[arg(long, value_name = "TETS", default_value_t = parafront_pipeline::DEFAULT_PART_TETS)]
+    part_tets: usize,
     /// Growth factor of the domain-defining grid (§5).
     #[arg(long)]
     ddg_growth: Option<f64>,
@@ -465,10 +471,11 @@ fn mesh_options(a: &MeshArgs) -> Result<MeshOptions, Fail> {
     o.ddg_cap = a.ddg_cap;
     o.fail_part = a.fail_part;
     o.release_memory = Some(release_memory);
-    if a.parts == 0 {
-        return Err(Fail(2, "--parts must be at least 1".into()));
+    if a.part_tets == 0 {
+        return Err(Fail(2, "--part-tets must be at least 1".into()));
     }
     o.parts = a.parts;
+    o.part_tets = a.part_tets;
     o.ddg_growth = a.ddg_growth.unwrap_or(0.0);
     o.partition = a.partition;
     o.ddg_passes = a.ddg_passes;
@@ -485,6 +492,18 @@ fn mesh_options(a: &MeshArgs) -> Result<MeshOptions, Fail> {
         ));
     }
     Ok(o)
+}
+
+/// `--parts`: `auto` (`parafront_pipeline::AUTO_PARTS`) or a count of
+/// at least 1.
+fn parse_parts(s: &str) -> Result<usize, String> {
+    if s == "auto" {
+        return Ok(parafront_pipeline::AUTO_PARTS);
+    }
+    match s.parse::<usize>() {
+        Ok(n) if n >= 1 => Ok(n),
+        _ => Err(format!("`{s}`: give auto or a count of 1 or more")),
+    }
 }
 
 fn run_mesh(s: &Surface, name: &str, out: &Path, a: &MeshArgs, w: &WriteArgs) -> Result<(), Fail> {
@@ -746,6 +765,17 @@ fn print_summary(sum: &Summary) {
     );
     if front > 0.0 {
         println!("front: {:.0} tets/s", sum.tets as f64 / front);
+    }
+    if let Some((parts, estimate)) = sum.auto_parts {
+        let how = if parts == 1 {
+            "the serial front".to_string()
+        } else {
+            format!("{parts} parts")
+        };
+        println!(
+            "parts (auto): {how}, for about {:.0}k tets estimated (--parts N sets them)",
+            estimate / 1e3
+        );
     }
     if !sum.voided_shells.is_empty() {
         let n = sum.voided_shells.len();

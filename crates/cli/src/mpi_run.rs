@@ -47,9 +47,14 @@ pub(crate) fn run_mesh(
     let (rank, ranks) = (mpi.rank(), mpi.ranks());
     let quiet = |f: Fail| quiet(rank, f);
     if a.parts < ranks {
+        let given = if a.parts == parafront_pipeline::AUTO_PARTS {
+            "auto".to_string()
+        } else {
+            a.parts.to_string()
+        };
         return Err(quiet(Fail(
             2,
-            format!("--parts {} under {ranks} MPI ranks: give every rank a part (--parts {ranks} or more)", a.parts),
+            format!("--parts {given} under {ranks} MPI ranks: give every rank a part (--parts {ranks} or more)"),
         )));
     }
     if a.pvtu.is_some() {

@@ -18,7 +18,6 @@
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 mod bcc;
-mod inside;
 mod octree;
 
 pub use bcc::{Lattice, LatticeCheckError};

@@ -1,8 +1,8 @@
 //! The lattice's blocks: the accepted leaves of an octree over the region
 //! (see the crate doc for the rules).
-use crate::inside::Inside;
 use crate::{LatticeOptions, CUBE_PER_SIZE};
 use parafront_geom::P3;
+use parafront_surface::inside::Inside;
 use rayon::prelude::*;
 use rustc_hash::{FxHashMap, FxHashSet};
 

@@ -5,6 +5,7 @@
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
+mod auto_parts;
 mod lattice;
 mod parts;
 mod pieces;
@@ -13,6 +14,7 @@ mod regions;
 mod share;
 mod summary;
 
+pub use auto_parts::{auto_parts, estimate_tets, AUTO_PARTS, DEFAULT_PART_TETS, MAX_AUTO_PARTS};
 pub use parafront_ddg::Partition;
 pub use regions::{material_regions, RegionFront};
 pub use summary::{Stage, Summary};
@@ -44,9 +46,16 @@ pub struct MeshOptions {
     pub threads: usize,
     /// Parts of the parallel mesher (the paper's nproc); 1 runs the serial
     /// front. With more, each region goes through the DDG, its partition
-    /// and the inside-out passes (§5 to §8).
-    #[serde(default = "one")]
+    /// and the inside-out passes (§5 to §8). [`AUTO_PARTS`] (0, the
+    /// default) picks them from the estimated tet count: one per
+    /// `part_tets`, serial under two ([`auto_parts`]); never from the
+    /// threads, so the mesh does not depend on them.
+    #[serde(default)]
     pub parts: usize,
+    /// With `parts` auto: one part per this many estimated tets
+    /// ([`DEFAULT_PART_TETS`]).
+    #[serde(default = "default_part_tets")]
+    pub part_tets: usize,
     /// DDG growth factor `c_i` (§5); 0 takes the default (1.6).
     #[serde(default)]
     pub ddg_growth: f64,
@@ -147,6 +156,10 @@ fn yes() -> bool {
     true
 }
 
+fn default_part_tets() -> usize {
+    DEFAULT_PART_TETS
+}
+
 fn default_thin_depth() -> f64 {
     ParOptions::default().thin_depth
 }
@@ -172,7 +185,8 @@ impl Default for MeshOptions {
         MeshOptions {
             size: SizeOptions::default(),
             threads: 0,
-            parts: 1,
+            parts: AUTO_PARTS,
+            part_tets: DEFAULT_PART_TETS,
             ddg_growth: 0.0,
             partition: parafront_ddg::Partition::default(),
             ddg_passes: None,
@@ -194,10 +208,6 @@ impl Default for MeshOptions {
             release_memory: None,
         }
     }
-}
-
-fn one() -> usize {
-    1
 }
 
 /// When the serial front leaves the interior to the lattice (§2).
@@ -266,6 +276,10 @@ pub enum MeshError {
     /// not allow.
     #[error("a partitioned output (.pvtu): {0}")]
     Partitioned(String),
+    /// Parts left to the estimate (`AUTO_PARTS`) over several processes,
+    /// which would each estimate alone.
+    #[error("the parts are chosen in one process only: give --parts under MPI")]
+    AutoPartsPerProcess,
     /// Improvement (§9) found the front's tets not face-adjacent.
     #[error("mesh improvement: {source}")]
     Improve {
@@ -328,7 +342,9 @@ fn mesh_surface_here<C: Comm>(
         opts
     } else {
         if opts.parts < 2 {
-            return Err(MeshError::Partitioned("it needs parts > 1".into()));
+            return Err(MeshError::Partitioned(
+                "it needs parts > 1 (--parts 2 or more)".into(),
+            ));
         }
         // The lattice's tets would be in no piece.
         pieces_only = MeshOptions {
@@ -381,9 +397,40 @@ fn mesh_surface_here<C: Comm>(
     // Each process builds its parts' share of the field's octree (one
     // process: all of it).
     let sizing = Sizing::build_shared(s, &opts.size, None, &share::CommShare(comm))?;
+    if opts.parts == AUTO_PARTS {
+        // One process holds every part: the threads backend, whose field
+        // does not depend on its parts.
+        if comm.owned() != (0..comm.parts()) {
+            return Err(MeshError::AutoPartsPerProcess);
+        }
+        let estimate = estimate_tets(s, &sizing);
+        let parts = auto_parts(estimate, opts.part_tets);
+        tracing::debug!(estimate, parts, "parts from the estimated tet count");
+        sum.auto_parts = Some((parts, estimate));
+        sum.push(Stage::SizeField, t0.elapsed().as_secs_f64());
+        opts.release();
+        let chosen = MeshOptions {
+            parts,
+            ..opts.clone()
+        };
+        let threads = parafront_comm::Threads::new(parts);
+        return mesh_sized(s, fronts, sizing, &chosen, &threads, sum);
+    }
     sum.push(Stage::SizeField, t0.elapsed().as_secs_f64());
     opts.release();
+    mesh_sized(s, fronts, sizing, opts, comm, sum)
+}
 
+/// The rest of [`mesh_surface_here`] once the size field stands: the
+/// front (serial, or the parts' passes), improvement, check and report.
+fn mesh_sized<C: Comm>(
+    s: &Surface,
+    fronts: Vec<RegionFront>,
+    sizing: Sizing,
+    opts: &MeshOptions,
+    comm: &C,
+    mut sum: Summary,
+) -> Result<Option<(TetMesh, Summary)>, MeshError> {
     let t0 = Instant::now();
     // The merged mesh starts from the surface where it is made: not on the
     // processes that only send their parts, nor anywhere in pieces mode.

@@ -90,6 +90,9 @@ impl fmt::Display for Stage {
 pub struct Summary {
     /// Threads the run had (`MeshOptions::threads`, or the pool's).
     pub threads: usize,
+    /// With `MeshOptions::parts` auto: the parts chosen, and the tets
+    /// estimated they were chosen from.
+    pub auto_parts: Option<(usize, f64)>,
     /// Tets of the mesh returned.
     pub tets: usize,
     /// Points of the mesh returned.

@@ -69,3 +69,46 @@ fn the_threads_option_is_honoured_and_leaves_the_mesh_alone() {
     assert_eq!(m1.tets, m3.tets);
     assert_eq!(m1.points, m3.points);
 }
+
+#[test]
+fn auto_parts_follow_the_estimate_not_the_threads() {
+    // `parts` auto (the default) with one part per 1,500 estimated tets:
+    // the torus gets several parts, the same mesh as those parts given
+    // outright, on 1 thread or 3; under a part per million tets it stays
+    // serial.
+    let s = generate::torus([0.0; 3], 2.0, 0.7, 24, 10);
+    let run = |parts: usize, part_tets: usize, threads: usize| {
+        let o = MeshOptions {
+            threads,
+            part_tets,
+            ..opts(parts, 0.35)
+        };
+        mesh_surface(&s, &o).unwrap()
+    };
+    let (m1, s1) = run(parafront_pipeline::AUTO_PARTS, 1_500, 1);
+    let (parts, estimate) = s1.auto_parts.expect("parts chosen");
+    assert!(parts > 1, "{parts} parts for {estimate} tets");
+    assert_eq!(parts, parafront_pipeline::auto_parts(estimate, 1_500));
+    assert_eq!(s1.parallel.len(), 1);
+    assert_eq!(s1.parallel[0].parts, parts);
+    // The estimate is the front's count before improvement (`opts`
+    // leaves it off), within half on this coarse torus (5,299 for 3,892;
+    // within 2 % on sphere_1e6 and torus_1e6).
+    let err = estimate / m1.tets.len() as f64 - 1.0;
+    assert!(
+        err.abs() < 0.5,
+        "{estimate} estimated, {} made",
+        m1.tets.len()
+    );
+    let (m3, _) = run(parafront_pipeline::AUTO_PARTS, 1_500, 3);
+    assert_eq!(m1.tets, m3.tets);
+    assert_eq!(m1.points, m3.points);
+    let (given, sg) = run(parts, 1_500, 2);
+    assert!(sg.auto_parts.is_none());
+    assert_eq!(m1.tets, given.tets);
+    let (serial, ss) = run(parafront_pipeline::AUTO_PARTS, 1_000_000, 2);
+    assert_eq!(ss.auto_parts.map(|a| a.0), Some(1));
+    assert!(ss.parallel.is_empty());
+    let (one, _) = run(1, 1_500, 2);
+    assert_eq!(serial.tets, one.tets);
+}

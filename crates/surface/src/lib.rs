@@ -4,6 +4,7 @@
 //! - [`read`]: the format readers (STL, OBJ, OFF, Gmsh .msh, Medit .mesh).
 //! - [`validate`]: open / non-manifold / orientation / degenerate /
 //!   self-intersection checks, and how the closed shells nest.
+//! - [`inside`]: whether a point lies inside the surface.
 //! - [`heal`]: merges the vertices a float rounding split apart, where
 //!   that closes open edges (opt-in; exact welding stays the default).
 #![forbid(unsafe_code)]
@@ -12,6 +13,7 @@
 pub mod generate;
 pub mod hard;
 pub mod heal;
+pub mod inside;
 pub mod read;
 pub mod validate;
 

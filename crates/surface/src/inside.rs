@@ -1,10 +1,12 @@
 //! Whether a point lies inside a closed surface: the parity of exact
 //! crossings along a ray in +x, over the triangles binned by their y-z
-//! box.
+//! box. The lattice keeps its cells inside with it, and the pipeline
+//! estimates a run's tet count.
 use parafront_geom::intersect::segment_triangle_parity;
 use parafront_geom::P3;
 
-pub(crate) struct Inside<'a> {
+/// A point-in-surface test over a closed triangulation.
+pub struct Inside<'a> {
     points: &'a [P3],
     faces: &'a [[u32; 3]],
     lo: [f64; 2],
@@ -15,7 +17,8 @@ pub(crate) struct Inside<'a> {
 }
 
 impl<'a> Inside<'a> {
-    pub(crate) fn new(points: &'a [P3], faces: &'a [[u32; 3]]) -> Inside<'a> {
+    /// The test for the closed surface `faces` over `points`.
+    pub fn new(points: &'a [P3], faces: &'a [[u32; 3]]) -> Inside<'a> {
         let mut lo = [f64::INFINITY; 2];
         let mut hi = [f64::NEG_INFINITY; 2];
         let mut xmax = f64::NEG_INFINITY;
@@ -67,7 +70,7 @@ impl<'a> Inside<'a> {
 
     /// `Some(inside)`, or `None` when the ray from `p` touches an edge or
     /// a corner (ask again from another point).
-    pub(crate) fn at(&self, p: P3) -> Option<bool> {
+    pub fn at(&self, p: P3) -> Option<bool> {
         if !(p[1] >= self.lo[0] && p[2] >= self.lo[1]) {
             return Some(false);
         }
