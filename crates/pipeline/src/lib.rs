@@ -482,9 +482,6 @@ fn mesh_sized<C: Comm>(
             .map_err(|source| MeshError::Improve { source })?;
         sum.improve = Some(st);
         sum.push(Stage::Improve, t0.elapsed().as_secs_f64());
-        // The pieces number the mesh before improvement, which swaps and
-        // collapses have changed: none is better than a stale one.
-        sum.pieces.clear();
         opts.release();
     }
 

@@ -137,7 +137,9 @@ pub struct Summary {
     /// Per region, what the parallel passes did (empty with one part).
     pub parallel: Vec<ParStats>,
     /// The partitioned mesh, one piece per region and part, with global
-    /// ids in the merged mesh's numbering (empty with one part).
+    /// ids in the merged mesh's numbering: with more than one part, when
+    /// the mesh stays in its pieces or improvement is off (improvement
+    /// renumbers the merged mesh).
     pub pieces: Vec<Piece>,
 }
 
