@@ -14,7 +14,9 @@ mod regions;
 mod share;
 mod summary;
 
-pub use auto_parts::{auto_parts, estimate_tets, AUTO_PARTS, DEFAULT_PART_TETS, MAX_AUTO_PARTS};
+pub use auto_parts::{
+    auto_parts, estimate_for_parts, estimate_tets, AUTO_PARTS, DEFAULT_PART_TETS, MAX_AUTO_PARTS,
+};
 pub use parafront_ddg::Partition;
 pub use regions::{material_regions, RegionFront};
 pub use summary::{Stage, Summary};
@@ -403,7 +405,7 @@ fn mesh_surface_here<C: Comm>(
         if comm.owned() != (0..comm.parts()) {
             return Err(MeshError::AutoPartsPerProcess);
         }
-        let estimate = estimate_tets(s, &sizing);
+        let estimate = estimate_for_parts(s, &sizing, opts.part_tets);
         let parts = auto_parts(estimate, opts.part_tets);
         tracing::debug!(estimate, parts, "parts from the estimated tet count");
         sum.auto_parts = Some((parts, estimate));
