@@ -146,13 +146,13 @@ struct MeshArgs {
     /// of their own; without it every inner shell is a void.
     #[arg(long)]
     regions: bool,
-    /// Parts of the parallel mesher (the paper's nproc): auto (one per
-    /// --part-tets estimated tets, the serial front under two; chosen
-    /// from the job, never from the threads, so the mesh does not depend
-    /// on them), 1 (the serial front) or more
+    /// Parts of the parallel mesher (the paper's nproc): auto (about one
+    /// per --part-tets estimated tets, the serial front under one and a
+    /// half; chosen from the job, never from the threads, so the mesh
+    /// does not depend on them), 1 (the serial front) or more
     #[arg(long, value_name = "auto|N", default_value = "auto", value_parser = parse_parts)]
     parts: usize,
-    /// With --parts auto: one part per this many estimated tets
+    /// With --parts auto: about one part per this many estimated tets
     #[arg(long, value_name = "TETS", default_value_t = parafront_pipeline::DEFAULT_PART_TETS)]
     part_tets: usize,
     /// Growth factor of the domain-defining grid (§5).

@@ -49,9 +49,9 @@ pub struct MeshOptions {
     /// Parts of the parallel mesher (the paper's nproc); 1 runs the serial
     /// front. With more, each region goes through the DDG, its partition
     /// and the inside-out passes (§5 to §8). [`AUTO_PARTS`] (0, the
-    /// default) picks them from the estimated tet count: one per
-    /// `part_tets`, serial under two ([`auto_parts`]); never from the
-    /// threads, so the mesh does not depend on them.
+    /// default) picks them from the estimated tet count: about one per
+    /// `part_tets`, serial under one and a half ([`auto_parts`]); never
+    /// from the threads, so the mesh does not depend on them.
     #[serde(default)]
     pub parts: usize,
     /// With `parts` auto: one part per this many estimated tets
