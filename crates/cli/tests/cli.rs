@@ -503,3 +503,44 @@ fn size_report_on_demand() {
     assert!(mean > 0.5 && mean < 2.0, "{line}");
     assert!(edges > tets_said(&text) as f64, "{line}");
 }
+
+/// `--parts auto`, the default: the summary says what it chose (the demo
+/// part is small: the serial front; under a small `--part-tets`, parts),
+/// and the mesh is that of the parts given outright. `--pvtu` needs parts
+/// given, and says so before meshing, writing nothing.
+#[test]
+fn auto_parts_are_reported_and_pieces_need_them_given() {
+    let run = |args: &[&str], out: &Path| {
+        let o = bin().args(args).arg("-o").arg(out).output().unwrap();
+        let text = String::from_utf8_lossy(&o.stdout).to_string();
+        let err = String::from_utf8_lossy(&o.stderr).to_string();
+        (o.status.code(), text, err)
+    };
+    let out = tmp("auto_parts.vtu");
+    let (code, text, err) = run(&["demo"], &out);
+    assert_eq!(code, Some(0), "{text}{err}");
+    assert!(text.contains("parts (auto): the serial front"), "{text}");
+    let (code, text, err) = run(&["demo", "--part-tets", "4000"], &out);
+    assert_eq!(code, Some(0), "{text}{err}");
+    let parts: usize = text
+        .split("parts (auto): ")
+        .nth(1)
+        .and_then(|t| t.split(' ').next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("no parts chosen: {text}"));
+    assert!(parts > 1, "{text}");
+    let given = tmp("given_parts.vtu");
+    let p = parts.to_string();
+    let (code, text2, err) = run(&["demo", "--parts", p.as_str()], &given);
+    assert_eq!(code, Some(0), "{text2}{err}");
+    assert_eq!(tets_said(&text), tets_said(&text2));
+    assert_eq!(std::fs::read(&out).unwrap(), std::fs::read(&given).unwrap());
+    let pv = tmp("auto_parts.pvtu");
+    let (code, _, err) = run(
+        &["demo", "--optimize", "0", "--pvtu", pv.to_str().unwrap()],
+        &tmp("pv.vtu"),
+    );
+    assert_eq!(code, Some(2));
+    assert!(err.contains("give --parts 2 or more"), "{err}");
+    assert!(!pv.exists() && !tmp("pv.vtu").exists());
+}
