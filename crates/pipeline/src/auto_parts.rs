@@ -5,7 +5,7 @@
 //! the passes pay that back only on large jobs. On one thread they do not
 //! (torus_1e6: 18-22 s serial, 25-27 s at 6 parts): the price of a mesh
 //! that is the same on any number of threads.
-use parafront_geom::P3;
+use parafront_geom::{Aabb, P3};
 use parafront_size::{SizeField, Sizing};
 use parafront_surface::inside::Inside;
 use parafront_surface::Surface;
@@ -35,11 +35,12 @@ const TETS_PER_IDEAL: f64 = 1.5;
 /// The estimate [`auto_parts`] takes at one part per `part_tets`: on a
 /// 16^3 grid, and on a 32^3 one unless the first gives under one part.
 pub fn estimate_for_parts(s: &Surface, sizing: &Sizing, part_tets: usize) -> f64 {
-    let coarse = estimate_tets(s, sizing, COARSE_GRID);
+    let inside = Inside::new(&s.points, &s.tris);
+    let coarse = estimate_with(s, sizing, &inside, COARSE_GRID);
     if coarse < part_tets as f64 {
         coarse
     } else {
-        estimate_tets(s, sizing, GRID)
+        estimate_with(s, sizing, &inside, GRID)
     }
 }
 
@@ -49,24 +50,21 @@ pub fn estimate_for_parts(s: &Surface, sizing: &Sizing, part_tets: usize) -> f64
 /// than a cell can come out at 0, which keeps it serial (the passes give
 /// up on thin parts anyway).
 pub fn estimate_tets(s: &Surface, sizing: &Sizing, grid: usize) -> f64 {
+    estimate_with(s, sizing, &Inside::new(&s.points, &s.tris), grid)
+}
+
+/// [`estimate_tets`] with `s`'s inside test built.
+fn estimate_with(s: &Surface, sizing: &Sizing, inside: &Inside, grid: usize) -> f64 {
     let grid = grid.max(1);
     if s.points.is_empty() {
         return 0.0;
     }
-    let mut lo = s.points[0];
-    let mut hi = s.points[0];
-    for p in &s.points {
-        for k in 0..3 {
-            lo[k] = lo[k].min(p[k]);
-            hi[k] = hi[k].max(p[k]);
-        }
-    }
+    let Aabb { min: lo, max: hi } = Aabb::from_points(&s.points);
     let cell = [0, 1, 2].map(|k| (hi[k] - lo[k]) / grid as f64);
     let vol = cell[0] * cell[1] * cell[2];
     if !(vol > 0.0) {
         return 0.0;
     }
-    let inside = Inside::new(&s.points, &s.tris);
     // Off the cell centres by odd fractions, a different one on each
     // axis: CAD faces sit on round coordinates, and a ray along a
     // triangle's edge (a square's diagonal, y = z) answers nothing; such a

@@ -399,9 +399,9 @@ fn mesh_surface_here<C: Comm>(
     // Each process builds its parts' share of the field's octree (one
     // process: all of it).
     let sizing = Sizing::build_shared(s, &opts.size, None, &share::CommShare(comm))?;
-    if opts.parts == AUTO_PARTS {
-        // One process holds every part: the threads backend, whose field
-        // does not depend on its parts.
+    // `parts` auto: chosen here, where the field stands (its octree does
+    // not depend on the parts on one process, the threads backend).
+    let auto = if opts.parts == AUTO_PARTS {
         if comm.owned() != (0..comm.parts()) {
             return Err(MeshError::AutoPartsPerProcess);
         }
@@ -409,18 +409,23 @@ fn mesh_surface_here<C: Comm>(
         let parts = auto_parts(estimate, opts.part_tets);
         tracing::debug!(estimate, parts, "parts from the estimated tet count");
         sum.auto_parts = Some((parts, estimate));
-        sum.push(Stage::SizeField, t0.elapsed().as_secs_f64());
-        opts.release();
-        let chosen = MeshOptions {
-            parts,
-            ..opts.clone()
-        };
-        let threads = parafront_comm::Threads::new(parts);
-        return mesh_sized(s, fronts, sizing, &chosen, &threads, sum);
-    }
+        Some(parts)
+    } else {
+        None
+    };
     sum.push(Stage::SizeField, t0.elapsed().as_secs_f64());
     opts.release();
-    mesh_sized(s, fronts, sizing, opts, comm, sum)
+    match auto {
+        Some(parts) => {
+            let chosen = MeshOptions {
+                parts,
+                ..opts.clone()
+            };
+            let threads = parafront_comm::Threads::new(parts);
+            mesh_sized(s, fronts, sizing, &chosen, &threads, sum)
+        }
+        None => mesh_sized(s, fronts, sizing, opts, comm, sum),
+    }
 }
 
 /// The rest of [`mesh_surface_here`] once the size field stands: the

@@ -137,7 +137,7 @@ pub(crate) fn mesh_parts<C: Comm>(
         // stale; they are a second copy of the mesh (13 of sphere_1e6's
         // 77 MB peak, which came in the improvement).
         let keep_pieces = !opts.gather || opts.optimize == 0;
-        if let (Some(base), true) = (pieces_base, keep_pieces) {
+        if let Some(base) = pieces_base.filter(|_| keep_pieces) {
             for mut pc in out.pieces {
                 for g in &mut pc.gid {
                     *g = global_id(rf, base, *g);
