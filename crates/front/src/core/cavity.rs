@@ -344,14 +344,22 @@ impl<'a> Front<'a> {
         bb
     }
 
-    /// Mean edge length of `faces`.
+    /// Mean edge length of the live faces of `faces`. A pocket can hold
+    /// faces a failed `close_by_existing` killed (it adds them again under
+    /// new ids), and a dead face's corners are gone once its chunk of the
+    /// store is (a random star-shaped sphere read corner `NONE` there).
     fn mean_edge(&self, faces: &[u32]) -> f64 {
-        let mut s = 0.0;
+        let (mut s, mut n) = (0.0, 0usize);
         for &f in faces {
-            let v = self.fv[f as usize].v.map(|i| self.pts[i as usize]);
+            let face = &self.fv[f as usize];
+            if !face.alive {
+                continue;
+            }
+            let v = face.v.map(|i| self.pts[i as usize]);
             s += (dist(v[0], v[1]) + dist(v[1], v[2]) + dist(v[2], v[0])) / 3.0;
+            n += 1;
         }
-        s / faces.len().max(1) as f64
+        s / n.max(1) as f64
     }
 
     /// Cone the faces of `set` that `x` sees and whose cones are free; `x`
