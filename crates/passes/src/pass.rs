@@ -119,6 +119,8 @@ pub(crate) fn front_call(
             .flat_map(|owned| inbox.iter().filter(move |m| m.1.owned == owned))
             .map(|(_, m)| &m.v),
     );
+    // The messages are copied into `input`: not held while the front runs.
+    drop(inbox);
     let filter = regions.filter(k);
     let input_ok: Vec<bool> = input
         .points
@@ -145,6 +147,11 @@ pub(crate) fn front_call(
         size.field,
     );
     let t_pockets = t0.elapsed().as_secs_f64() - t_front;
+    // The parts' results wait for each other: no growth slack kept.
+    res.points.shrink_to_fit();
+    res.point_size.shrink_to_fit();
+    res.tets.shrink_to_fit();
+    res.neigh.shrink_to_fit();
     let stuck: Vec<bool> = res
         .front
         .iter()
