@@ -1,0 +1,261 @@
+//! One part of the passes (§7): the records its messages carry, its
+//! local points, tets and front, and what one front call gave back.
+use parafront_comm::{Wire, WireError};
+use parafront_geom::P3;
+use rustc_hash::FxHashMap;
+
+/// A point as it travels in a message: its global id, where it is, its size.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Rec {
+    pub(crate) gid: u32,
+    pub(crate) p: P3,
+    pub(crate) h: f64,
+}
+
+impl Wire for Rec {
+    fn put(&self, buf: &mut Vec<u8>) {
+        (self.gid, self.p, self.h).put(buf);
+    }
+    fn get(buf: &mut &[u8]) -> Result<Self, WireError> {
+        let (gid, p, h) = Wire::get(buf)?;
+        Ok(Rec { gid, p, h })
+    }
+}
+
+/// A front face in a message: owned (the part advances it) or context
+/// (the part only has to know it is there).
+pub(crate) struct FaceMsg {
+    pub(crate) owned: bool,
+    pub(crate) v: [Rec; 3],
+}
+
+impl Wire for FaceMsg {
+    fn put(&self, buf: &mut Vec<u8>) {
+        (self.owned, self.v).put(buf);
+    }
+    fn get(buf: &mut &[u8]) -> Result<Self, WireError> {
+        let (owned, v) = Wire::get(buf)?;
+        Ok(FaceMsg { owned, v })
+    }
+}
+
+/// One part's local data.
+#[derive(Default)]
+pub(crate) struct Part {
+    pub(crate) pts: Vec<P3>,
+    pub(crate) size: Vec<f64>,
+    pub(crate) gid: Vec<u32>,
+    pub(crate) index: FxHashMap<u32, u32>,
+    /// Local ids.
+    pub(crate) tets: Vec<[u32; 4]>,
+    pub(crate) tet_pass: Vec<u8>,
+    /// The faces this part holds, local ids.
+    pub(crate) front: Vec<[u32; 3]>,
+    /// Global ids of the points of the faces that got stuck in its last
+    /// front call (region rules allowed them, the front could not).
+    pub(crate) stuck: Vec<u32>,
+}
+
+/// The parts `owned` holds, with the input front in `holders` blocks of
+/// consecutive faces on parts `0..holders`. The DDG's passes seed part 0
+/// only (the reader); the fine passes seed every part, so that no process
+/// routes the whole front in pass 1 (on sphere_5e6 at 4 ranks, part 0's
+/// faces and their copies for the parts their boxes meet were 45 MB on
+/// rank 0 alone). Pass 1 sends them out.
+pub(crate) fn seed_parts(
+    owned: std::ops::Range<usize>,
+    holders: usize,
+    points: &[P3],
+    point_size: &[f64],
+    faces: &[[u32; 3]],
+) -> Vec<Part> {
+    let mut parts: Vec<Part> = owned.clone().map(|_| Part::default()).collect();
+    let holders = holders.max(1);
+    for k in owned.clone().filter(|&k| k < holders) {
+        let part = &mut parts[k - owned.start];
+        let block = k * faces.len() / holders..(k + 1) * faces.len() / holders;
+        for f in &faces[block] {
+            let v = f.map(|i| {
+                part.local(Rec {
+                    gid: i,
+                    p: points[i as usize],
+                    h: point_size[i as usize],
+                })
+            });
+            part.front.push(v);
+        }
+    }
+    parts
+}
+
+impl Part {
+    pub(crate) fn local(&mut self, r: Rec) -> u32 {
+        if let Some(&i) = self.index.get(&r.gid) {
+            return i;
+        }
+        let i = self.pts.len() as u32;
+        self.pts.push(r.p);
+        self.size.push(r.h);
+        self.gid.push(r.gid);
+        self.index.insert(r.gid, i);
+        i
+    }
+    pub(crate) fn rec(&self, i: u32) -> Rec {
+        Rec {
+            gid: self.gid[i as usize],
+            p: self.pts[i as usize],
+            h: self.size[i as usize],
+        }
+    }
+
+    /// The part's invariants, for the tests and debug builds (after every
+    /// pass): one point record per local id, the index maps each global
+    /// id to its local one and nothing else, every tet and face names local
+    /// points (distinct ones), and each tet has the pass that made it.
+    pub(crate) fn check(&self) -> Result<(), PartCheckError> {
+        let n = self.pts.len();
+        if self.size.len() != n || self.gid.len() != n || self.index.len() != n {
+            return Err(PartCheckError::Lengths);
+        }
+        if let Some(i) = (0..n).find(|&i| self.index.get(&self.gid[i]) != Some(&(i as u32))) {
+            return Err(PartCheckError::Index(self.gid[i]));
+        }
+        if self.tet_pass.len() != self.tets.len() {
+            return Err(PartCheckError::Lengths);
+        }
+        let bad = |v: &[u32]| {
+            v.iter().any(|&i| i as usize >= n)
+                || (0..v.len()).any(|a| (a + 1..v.len()).any(|b| v[a] == v[b]))
+        };
+        if let Some(t) = self.tets.iter().position(|t| bad(t)) {
+            return Err(PartCheckError::Tet(t));
+        }
+        if let Some(f) = self.front.iter().position(|f| bad(f)) {
+            return Err(PartCheckError::Face(f));
+        }
+        Ok(())
+    }
+}
+
+/// What [`Part::check`] found wrong.
+#[derive(Debug, PartialEq, Eq, thiserror::Error)]
+pub(crate) enum PartCheckError {
+    #[error("the part's per-point or per-tet arrays differ in length")]
+    Lengths,
+    #[error("the part's index does not map global point {0} to its local id")]
+    Index(u32),
+    #[error("the part's tet {0} names a missing point or repeats one")]
+    Tet(usize),
+    #[error("the part's front face {0} names a missing point or repeats one")]
+    Face(usize),
+}
+
+/// [`Part::check`] on every part, in debug builds.
+pub(crate) fn debug_check_parts(parts: &[Part], after: impl std::fmt::Display) {
+    if cfg!(debug_assertions) {
+        for (k, p) in parts.iter().enumerate() {
+            if let Err(e) = p.check() {
+                panic!("part {k} after {after}: {e}");
+            }
+        }
+    }
+}
+
+/// What one part's front call gave back, before new points get global ids.
+pub(crate) struct Made {
+    pub(crate) res: Option<parafront_front::FrontResult>,
+    /// Global ids of the input points.
+    pub(crate) input_gid: Vec<u32>,
+    /// Input points inside this part (conservative assignment).
+    pub(crate) input_ok: Vec<bool>,
+    /// Per face of `res.front`: stuck rather than held by the region.
+    pub(crate) stuck: Vec<bool>,
+    pub(crate) seconds: f64,
+}
+
+impl Made {
+    /// The points the front call made (global ids to be given).
+    pub(crate) fn new_points(&self) -> u32 {
+        self.res
+            .as_ref()
+            .map_or(0, |r| (r.points.len() - self.input_gid.len()) as u32)
+    }
+}
+
+#[cfg(test)]
+mod part_check_tests {
+    use super::*;
+
+    #[test]
+    fn a_sound_part_passes_and_each_fault_is_named() {
+        let mut p = Part::default();
+        let ids: Vec<u32> = (0..4)
+            .map(|g| {
+                p.local(Rec {
+                    gid: 10 + g,
+                    p: [g as f64, 0.0, 0.0],
+                    h: 1.0,
+                })
+            })
+            .collect();
+        p.tets.push([ids[0], ids[1], ids[2], ids[3]]);
+        p.tet_pass.push(1);
+        p.front.push([ids[0], ids[2], ids[1]]);
+        assert_eq!(p.check(), Ok(()));
+        p.tets[0][3] = ids[0];
+        assert_eq!(p.check(), Err(PartCheckError::Tet(0)));
+        p.tets[0][3] = 9;
+        assert_eq!(p.check(), Err(PartCheckError::Tet(0)));
+        p.tets[0][3] = ids[3];
+        p.front[0][1] = 7;
+        assert_eq!(p.check(), Err(PartCheckError::Face(0)));
+        p.front[0][1] = ids[2];
+        p.index.insert(10, 3);
+        assert_eq!(p.check(), Err(PartCheckError::Index(10)));
+        p.index.insert(10, 0);
+        p.tet_pass.clear();
+        assert_eq!(p.check(), Err(PartCheckError::Lengths));
+    }
+}
+
+#[cfg(test)]
+mod seed_tests {
+    use super::*;
+    use parafront_geom::P3;
+
+    /// The input front as global ids, part by part, from the parts of
+    /// every holder in `ranks` (ranges of part ids).
+    fn seeded(ranks: &[std::ops::Range<usize>], holders: usize, n: u32) -> Vec<Vec<[u32; 3]>> {
+        let points: Vec<P3> = (0..n + 2).map(|i| [i as f64, 0.0, 0.0]).collect();
+        let size = vec![1.0; points.len()];
+        let faces: Vec<[u32; 3]> = (0..n).map(|i| [i, i + 1, i + 2]).collect();
+        let mut out = Vec::new();
+        for r in ranks {
+            for p in seed_parts(r.clone(), holders, &points, &size, &faces) {
+                assert_eq!(p.check(), Ok(()));
+                out.push(
+                    p.front
+                        .iter()
+                        .map(|f| f.map(|i| p.gid[i as usize]))
+                        .collect(),
+                );
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn spread_seeding_gives_each_part_a_block_in_face_order() {
+        let all: Vec<[u32; 3]> = (0..101).map(|i| [i, i + 1, i + 2]).collect();
+        // One process or three: the same blocks, every face once, in order.
+        let one = seeded(std::slice::from_ref(&(0..8)), 8, 101);
+        let three = seeded(&[0..3, 3..6, 6..8], 8, 101);
+        assert_eq!(one, three);
+        assert_eq!(one.concat(), all);
+        assert!(one.iter().all(|b| (12..=13).contains(&b.len())), "{one:?}");
+        // One holder: all on part 0.
+        let held = seeded(&[0..3, 3..8], 1, 101);
+        assert_eq!(held[0], all);
+        assert!(held[1..].iter().all(Vec::is_empty));
+    }
+}
