@@ -177,7 +177,7 @@ def meshcheck(surf, mesh, healed):
     return p.returncode == 0
 
 
-def run_peers(surf, peers, threads, repeat, jsonl, h="auto"):
+def run_peers(surf, peers, threads, repeat, jsonl, h="auto", timeout=600):
     if not peers:
         return []
     script = os.path.join(SHARED, "tools", "peers", "peer_mesh.py")
@@ -186,7 +186,7 @@ def run_peers(surf, peers, threads, repeat, jsonl, h="auto"):
         if os.path.exists(jsonl):
             os.remove(jsonl)
         cmd = [sys.executable, script, surf, "--peers", ",".join(peers), "--h", h,
-               "--threads", ",".join(map(str, threads)), "--jsonl", jsonl, "--timeout", "600"]
+               "--threads", ",".join(map(str, threads)), "--jsonl", jsonl, "--timeout", str(timeout)]
         # In the scratch folder: TetGen leaves files in its working folder.
         p = subprocess.run(cmd, capture_output=True, text=True, cwd=os.path.dirname(jsonl))
         if os.path.exists(jsonl):
@@ -212,6 +212,8 @@ def main():
     ap.add_argument("--peers", default="gmsh-hxt,tetgen,netgen",
                     help="peer_mesh.py names, or none")
     ap.add_argument("--peer-repeat", type=int, default=1)
+    ap.add_argument("--peer-timeout", type=int, default=600,
+                    help="seconds a peer gets per input and thread count (then: fails: timeout)")
     ap.add_argument("--binary", default=os.path.join(ROOT, "target", "release", "parafront"))
     ap.add_argument("--out", default=os.path.join(ROOT, "BENCHMARKS.md"))
     ap.add_argument("--append", action="store_true",
@@ -280,7 +282,8 @@ def main():
             # Peers mesh what parafront meshed: the healed surface for dirty/.
             peer_surf = healed if healed and os.path.exists(healed) else surf
             h = extra[extra.index("--size") + 1] if "--size" in extra else "auto"
-            for r in run_peers(peer_surf, peers, threads, a.peer_repeat, os.path.join(work, "peers.jsonl"), h):
+            for r in run_peers(peer_surf, peers, threads, a.peer_repeat, os.path.join(work, "peers.jsonl"), h,
+                               a.peer_timeout):
                 if r.get("status") != "ok":
                     rows.append([name, r["peer"], r["threads"], "fails: " + str(r.get("status"))])
                     continue
@@ -384,7 +387,8 @@ def header(L, a, started, rev, cpu):
     L.append("```\ncargo build --release -p parafront\npip install numpy meshio gmsh tetgen netgen-mesher\n"
              f"python3 scripts/bench.py --sets {a.sets}{' --only ' + a.only if a.only else ''} "
              f"--threads {a.threads} --repeat {a.repeat} "
-             f"--peers {a.peers or 'none'}\n```\n")
+             f"--peers {a.peers or 'none'}"
+             f"{' --peer-timeout ' + str(a.peer_timeout) if a.peer_timeout != 600 else ''}\n```\n")
     L.append(f"Sitting: {started}, commit {rev}, {os.cpu_count()} cores ({cpu}).\n")
     L.append("- **parafront**: the whole `parafront mesh` run as a user times it (default options, "
              "`--threads` as given; read, size field, front, improvement, check, quality, write), "
