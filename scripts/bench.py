@@ -327,9 +327,7 @@ def write(a, sections, started, threads, peers):
         pass
     L = []
     if a.append:
-        only = f" --only {a.only}" if a.only else ""
-        L.append(f"## Sitting {started} (commit {rev}): `scripts/bench.py --sets {a.sets}{only} "
-                 f"--threads {a.threads} --repeat {a.repeat} --peers {a.peers or 'none'}`\n")
+        L.append(f"## Sitting {started} (commit {rev}): `{command(a)}`\n")
     else:
         header(L, a, started, rev, cpu)
     for name, rows, stage_rows in sections:
@@ -381,14 +379,18 @@ def write(a, sections, started, threads, peers):
         f.write(("\n" if a.append else "") + "\n".join(L) + "\n")
 
 
+def command(a):
+    """The options of this sitting, as a command line (the header's and an appended section's)."""
+    return (f"scripts/bench.py --sets {a.sets}{' --only ' + a.only if a.only else ''} "
+            f"--threads {a.threads} --repeat {a.repeat} --peers {a.peers or 'none'}"
+            f"{' --peer-timeout ' + str(a.peer_timeout) if a.peer_timeout != 600 else ''}")
+
+
 def header(L, a, started, rev, cpu):
     L.append("# Benchmarks\n")
     L.append("Written by `scripts/bench.py`; do not edit by hand. To reproduce:\n")
     L.append("```\ncargo build --release -p parafront\npip install numpy meshio gmsh tetgen netgen-mesher\n"
-             f"python3 scripts/bench.py --sets {a.sets}{' --only ' + a.only if a.only else ''} "
-             f"--threads {a.threads} --repeat {a.repeat} "
-             f"--peers {a.peers or 'none'}"
-             f"{' --peer-timeout ' + str(a.peer_timeout) if a.peer_timeout != 600 else ''}\n```\n")
+             f"python3 {command(a)}\n```\n")
     L.append(f"Sitting: {started}, commit {rev}, {os.cpu_count()} cores ({cpu}).\n")
     L.append("- **parafront**: the whole `parafront mesh` run as a user times it (default options, "
              "`--threads` as given; read, size field, front, improvement, check, quality, write), "

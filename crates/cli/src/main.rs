@@ -481,14 +481,14 @@ fn mesh_options(a: &MeshArgs) -> Result<MeshOptions, Fail> {
     o.ddg_growth = a.ddg_growth.unwrap_or(0.0);
     o.partition = a.partition;
     o.ddg_passes = a.ddg_passes;
-    if a.pvtu.is_some() && a.parts < 2 {
-        // Checked before the run: auto parts keep a small job serial.
-        return Err(Fail(
-            2,
-            "--pvtu writes the parallel passes' parts: give --parts 2 or more".into(),
-        ));
-    }
     if a.pvtu.is_some() {
+        // Checked before the run: auto parts keep a small job serial.
+        if a.parts < 2 {
+            return Err(Fail(
+                2,
+                "--pvtu writes the parallel passes' parts: give --parts 2 or more".into(),
+            ));
+        }
         // The pieces are the passes' parts; the lattice's tets are in none.
         o.lattice = parafront_pipeline::LatticeMode::Off;
     }
