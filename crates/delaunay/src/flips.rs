@@ -125,38 +125,63 @@ impl Triangulation {
     /// The tets around edge `p`-`q` and the ring of their other corners in
     /// order, or `None` when the ring is open or the edge is missing.
     pub(crate) fn edge_ring(&self, p: u32, q: u32) -> Option<(Vec<u32>, Vec<u32>)> {
+        if let Some((mp, mq, g, tets, ring)) = &*self.ring_memo.borrow() {
+            if (*mp, *mq, *g) == (p, q, self.generation) {
+                return Some((tets.clone(), ring.clone()));
+            }
+        }
+        let out = self.edge_ring_walk(p, q)?;
+        *self.ring_memo.borrow_mut() = Some((p, q, self.generation, out.0.clone(), out.1.clone()));
+        Some(out)
+    }
+
+    fn edge_ring_walk(&self, p: u32, q: u32) -> Option<(Vec<u32>, Vec<u32>)> {
         // Not from a bounding corner, whose star holds the hull.
         let (a, b) = if p < 4 { (q, p) } else { (p, q) };
-        let tets: Vec<u32> = self
-            .star(a)
-            .into_iter()
-            .filter(|&t| self.tets[t as usize].contains(&b))
-            .collect();
+        let mut tets: Vec<u32> = Vec::new();
+        self.star_find(a, |t| {
+            if self.tets[t as usize].contains(&b) {
+                tets.push(t);
+            }
+            false
+        });
         if tets.len() < 3 {
             return None;
         }
         // Each tet as (its two other corners in the order that makes
-        // (p, q, r0, r1) positive).
-        let mut next: FxHashMap<u32, u32> = FxHashMap::default();
+        // (p, q, r0, r1) positive); a ring is short, so a list serves.
+        let mut next: Vec<(u32, u32)> = Vec::with_capacity(tets.len());
         for &t in &tets {
-            let o: Vec<u32> = self.tets[t as usize]
-                .iter()
-                .copied()
-                .filter(|&v| v != p && v != q)
-                .collect();
+            let tv = self.tets[t as usize];
+            let mut o = [0u32; 2];
+            let mut k = 0;
+            for &v in &tv {
+                if v != p && v != q {
+                    o[k.min(1)] = v;
+                    k += 1;
+                }
+            }
+            if k != 2 {
+                return None; // p or q twice: not a tet on the edge
+            }
             let pts = [p, q, o[0], o[1]].map(|v| self.pts[v as usize]);
             let (r0, r1) = if orient3d(pts[0], pts[1], pts[2], pts[3]) > 0.0 {
                 (o[0], o[1])
             } else {
                 (o[1], o[0])
             };
-            next.insert(r0, r1);
+            // A later tet with the same r0 replaced the earlier (a map's
+            // insert).
+            match next.iter_mut().find(|e| e.0 == r0) {
+                Some(e) => e.1 = r1,
+                None => next.push((r0, r1)),
+            }
         }
-        let start = *next.keys().min()?;
+        let start = next.iter().map(|e| e.0).min()?;
         let mut ring = vec![start];
         let mut v = start;
         for _ in 0..tets.len() {
-            v = *next.get(&v)?;
+            v = next.iter().find(|e| e.0 == v)?.1;
             if v == start {
                 break;
             }
@@ -284,5 +309,99 @@ impl Triangulation {
             return Flip::Done;
         }
         Flip::NotConvex
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use parafront_geom::P3;
+
+    fn points(n: usize, mut s: u64) -> Vec<P3> {
+        let mut r = || {
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (s >> 11) as f64 / (1u64 << 53) as f64
+        };
+        (0..n).map(|_| [r(), r(), r()]).collect()
+    }
+
+    /// The edges of live tets between given points (ids from 4).
+    fn inner_edges(tri: &Triangulation) -> Vec<(u32, u32)> {
+        let mut e: Vec<(u32, u32)> = tri
+            .live_tets()
+            .flat_map(|t| {
+                let v = tri.tet(t);
+                [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)]
+                    .map(|(a, b)| (v[a].min(v[b]), v[a].max(v[b])))
+            })
+            .filter(|&(a, _)| a >= 4)
+            .collect();
+        e.sort_unstable();
+        e.dedup();
+        e
+    }
+
+    /// Each edge's ring holds exactly the live tets on both ends, its
+    /// memo answers as a fresh walk does, also after flips change the
+    /// tets; `find_face` finds the first tet of the star that holds the
+    /// face, as a scan of the whole star does.
+    #[test]
+    fn rings_and_faces_match_a_fresh_search_after_flips() {
+        let mut tri = Triangulation::new(&points(80, 7)).unwrap();
+        let none = FxHashSet::default();
+        for round in 0..40 {
+            for (p, q) in inner_edges(&tri) {
+                let fresh = tri.edge_ring_walk(p, q);
+                assert_eq!(tri.edge_ring(p, q), fresh, "round {round}, edge {p}-{q}");
+                assert_eq!(tri.edge_ring(p, q), fresh, "memo, edge {p}-{q}");
+                if let Some((tets, ring)) = fresh {
+                    let mut on: Vec<u32> = tri
+                        .live_tets()
+                        .filter(|&t| tri.tet(t).contains(&p) && tri.tet(t).contains(&q))
+                        .collect();
+                    let mut got = tets.clone();
+                    on.sort_unstable();
+                    got.sort_unstable();
+                    assert_eq!(got, on);
+                    assert_eq!(ring.len(), tets.len());
+                }
+            }
+            for t in tri.live_tets().collect::<Vec<_>>() {
+                for f in 0..4 {
+                    let w = tri.face_corners(4 * t + f);
+                    let a = w.iter().copied().find(|&x| x >= 4).unwrap_or(w[0]);
+                    let first = tri
+                        .star(a)
+                        .into_iter()
+                        .find(|&u| w.iter().all(|x| tri.tet(u).contains(x)))
+                        .unwrap();
+                    let fr = tri.find_face(w).unwrap();
+                    assert_eq!(fr >> 2, first);
+                    assert_eq!(key3(tri.face_corners(fr)), key3(w));
+                }
+            }
+            // Change the tets around an edge whose ring was just asked: a
+            // 2-3 flip of a face on it takes a corner out of its ring, or
+            // else the edge's removal.
+            let edges = inner_edges(&tri);
+            let (p, q) = edges[(round * 37) % edges.len()];
+            let Some((_, ring)) = tri.edge_ring(p, q) else {
+                continue;
+            };
+            let flipped = ring.iter().any(|&r| {
+                let fr = tri.find_face([p, q, r]).unwrap();
+                tri.flip23(fr, &none) == Flip::Done
+            });
+            if flipped {
+                let (_, after) = tri.edge_ring(p, q).unwrap();
+                assert!(after.len() < ring.len());
+                assert_eq!(tri.edge_ring(p, q), tri.edge_ring_walk(p, q));
+            } else {
+                tri.remove_edge(p, q, &none);
+            }
+            tri.check().unwrap();
+        }
     }
 }

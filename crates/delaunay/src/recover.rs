@@ -8,7 +8,7 @@
 use crate::flips::{key3, Flip};
 use crate::tri::{Triangulation, NONE, TET_FACES};
 use parafront_geom::{add, cross, orient3d, sub, P3};
-use rustc_hash::FxHashSet;
+use rustc_hash::{FxHashMap, FxHashSet};
 
 /// Recover every face of `cf` it can, in passes while any pass gains one;
 /// the indices of the faces still missing.
@@ -109,7 +109,11 @@ fn segment_crossings(tri: &Triangulation, a: u32, b: u32) -> (Vec<(u32, u32)>, V
                 continue;
             }
             let wp = w.map(|v| tri.pts[v as usize]);
-            if !pierces(pa, pb, wp) {
+            let sides = (
+                orient3d(wp[0], wp[1], wp[2], pa),
+                orient3d(wp[0], wp[1], wp[2], pb),
+            );
+            if !pierces(pa, pb, wp, sides) {
                 continue;
             }
             // The edge it passes through, if any.
@@ -344,6 +348,15 @@ pub(crate) fn crossings(tri: &Triangulation, f: [u32; 3]) -> (Vec<(u32, u32)>, V
     let mut eseen: FxHashSet<(u32, u32)> = FxHashSet::default();
     let mut faces: Vec<u32> = Vec::new();
     let mut fseen: FxHashSet<[u32; 3]> = FxHashSet::default();
+    // Each point's side of the face's plane, once: on a CAD plane most are
+    // zero, the exact predicate's slowest answer, and every point ends
+    // several edges.
+    let mut side: FxHashMap<u32, f64> = FxHashMap::default();
+    let mut side_of = |v: u32| {
+        *side
+            .entry(v)
+            .or_insert_with(|| orient3d(p[0], p[1], p[2], tri.pts[v as usize]))
+    };
     for &t in &near {
         let tv = tri.tet(t);
         for a in 0..4 {
@@ -352,7 +365,8 @@ pub(crate) fn crossings(tri: &Triangulation, f: [u32; 3]) -> (Vec<(u32, u32)>, V
                 if f.contains(&u) && f.contains(&v) || !eseen.insert((u, v)) {
                     continue;
                 }
-                if edge_blocks(tri, p, f, off, u, v) {
+                let sides = (side_of(u), side_of(v));
+                if edge_blocks(tri, p, f, off, (u, v), sides) {
                     edges.push((u, v));
                 }
             }
@@ -363,11 +377,15 @@ pub(crate) fn crossings(tri: &Triangulation, f: [u32; 3]) -> (Vec<(u32, u32)>, V
                 continue;
             }
             let wp = w.map(|v| tri.pts[v as usize]);
+            // The face's corners' sides of this plane, each once.
+            let mut o: [Option<f64>; 3] = [None; 3];
+            let mut o_of =
+                |k: usize| *o[k].get_or_insert_with(|| orient3d(wp[0], wp[1], wp[2], p[k]));
             let pierced = (0..3).any(|e| {
                 let (a, b) = (f[e], f[(e + 1) % 3]);
                 !w.contains(&a)
                     && !w.contains(&b)
-                    && pierces(tri.pts[a as usize], tri.pts[b as usize], wp)
+                    && pierces(p[e], p[(e + 1) % 3], wp, (o_of(e), o_of((e + 1) % 3)))
             });
             if pierced {
                 faces.push(4 * t + k as u32);
@@ -380,10 +398,16 @@ pub(crate) fn crossings(tri: &Triangulation, f: [u32; 3]) -> (Vec<(u32, u32)>, V
 /// Edge `u`-`v` meets face `f` (points `p`) elsewhere than along its own
 /// edges' ends: through its interior, or through one of its edges, or
 /// lying in its plane across it.
-fn edge_blocks(tri: &Triangulation, p: [P3; 3], f: [u32; 3], off: P3, u: u32, v: u32) -> bool {
+/// `sides`: the orientations of `u` and `v` against the face's plane.
+fn edge_blocks(
+    tri: &Triangulation,
+    p: [P3; 3],
+    f: [u32; 3],
+    off: P3,
+    (u, v): (u32, u32),
+    (ou, ov): (f64, f64),
+) -> bool {
     let (pu, pv) = (tri.pts[u as usize], tri.pts[v as usize]);
-    let ou = orient3d(p[0], p[1], p[2], pu);
-    let ov = orient3d(p[0], p[1], p[2], pv);
     if opp(ou, ov) {
         let s = [
             orient3d(pu, pv, p[0], p[1]),
@@ -420,10 +444,9 @@ fn edge_blocks(tri: &Triangulation, p: [P3; 3], f: [u32; 3], off: P3, u: u32, v:
 }
 
 /// Segment `a`-`b` passes through triangle `w` (its interior or an edge's
-/// interior), its ends strictly on either side.
-fn pierces(a: P3, b: P3, w: [P3; 3]) -> bool {
-    let oa = orient3d(w[0], w[1], w[2], a);
-    let ob = orient3d(w[0], w[1], w[2], b);
+/// interior), its ends strictly on either side (`oa`, `ob`: their
+/// orientations against `w`'s plane).
+fn pierces(a: P3, b: P3, w: [P3; 3], (oa, ob): (f64, f64)) -> bool {
     if !opp(oa, ob) {
         return false;
     }

@@ -28,6 +28,10 @@ pub enum InsertError {
 /// A tetrahedralization of a bounding tet: struct of arrays, `u32` ids,
 /// `neigh[4t+f] = 4u+g` (or [`NONE`] on the bounding tet's faces).
 ///
+/// An edge's ring as [`Triangulation::edge_ring`] gave it: `(p, q,
+/// generation, tets, ring)`.
+pub(crate) type RingMemo = (u32, u32, u64, Vec<u32>, Vec<u32>);
+
 /// Points `0..4` are the bounding tet's corners; the points given to
 /// [`Triangulation::new`] follow in order. Dead tets keep their slot (their
 /// `alive` is false) and are reused.
@@ -47,7 +51,13 @@ pub struct Triangulation {
     epoch: u32,
     /// Scratch for [`Triangulation::star`]: a mark per tet slot and its
     /// epoch.
-    star_mark: std::cell::RefCell<(Vec<u32>, u32)>,
+    star_mark: std::cell::RefCell<(Vec<u32>, u32, Vec<u32>)>,
+    /// Bumped by every change of the tets, for the memo below.
+    pub(crate) generation: u64,
+    /// The last [`Triangulation::edge_ring`] asked: its edge, the
+    /// generation it holds for, and its answer (an edge removal asks for
+    /// the same ring three times before it changes anything).
+    pub(crate) ring_memo: std::cell::RefCell<Option<RingMemo>>,
 }
 
 impl Triangulation {
@@ -113,6 +123,8 @@ impl Triangulation {
             mark: vec![0],
             epoch: 0,
             star_mark: Default::default(),
+            generation: 0,
+            ring_memo: Default::default(),
         })
         .map(|mut t| {
             for k in 0..4 {
@@ -349,8 +361,7 @@ impl Triangulation {
             }
         }
         for &t in cav {
-            self.alive[t as usize] = false;
-            self.free.push(t);
+            self.kill_tet(t);
         }
         let mut edges: FxHashMap<(u32, u32), u32> = FxHashMap::default();
         for (nb, w) in bnd {
@@ -384,6 +395,7 @@ impl Triangulation {
     }
 
     pub(crate) fn new_tet(&mut self, tv: [u32; 4]) -> u32 {
+        self.generation += 1;
         if let Some(t) = self.free.pop() {
             self.tets[t as usize] = tv;
             self.alive[t as usize] = true;
@@ -402,6 +414,7 @@ impl Triangulation {
     }
 
     pub(crate) fn kill_tet(&mut self, t: u32) {
+        self.generation += 1;
         self.alive[t as usize] = false;
         self.free.push(t);
     }
@@ -418,19 +431,27 @@ impl Triangulation {
 
     /// The live tets around point `v`.
     pub fn star(&self, v: u32) -> Vec<u32> {
+        let mut out = Vec::new();
+        self.star_find(v, |t| {
+            out.push(t);
+            false
+        });
+        out
+    }
+
+    /// The tets of [`Triangulation::star`], in its order, handed to `stop`
+    /// until it returns true; that tet, or `None`. The searches of one face
+    /// or edge stop at their first hit rather than build the whole star
+    /// (they were a sixth of a CAD cavity's fill).
+    pub(crate) fn star_find(&self, v: u32, mut stop: impl FnMut(u32) -> bool) -> Option<u32> {
         let mut t0 = self.vtet[v as usize];
         if t0 == NONE || !self.alive[t0 as usize] || !self.tets[t0 as usize].contains(&v) {
-            match self
+            t0 = self
                 .live_tets()
-                .find(|&t| self.tets[t as usize].contains(&v))
-            {
-                Some(t) => t0 = t,
-                None => return Vec::new(),
-            }
+                .find(|&t| self.tets[t as usize].contains(&v))?;
         }
-        let mut out = vec![t0];
         let mut scratch = self.star_mark.borrow_mut();
-        let (marks, epoch) = &mut *scratch;
+        let (marks, epoch, queue) = &mut *scratch;
         *epoch = epoch.wrapping_add(1);
         if *epoch == 0 {
             marks.iter_mut().for_each(|m| *m = 0);
@@ -439,9 +460,14 @@ impl Triangulation {
         let ep = *epoch;
         marks.resize(self.tets.len(), 0);
         marks[t0 as usize] = ep;
+        queue.clear();
+        queue.push(t0);
+        if stop(t0) {
+            return Some(t0);
+        }
         let mut i = 0;
-        while i < out.len() {
-            let t = out[i];
+        while i < queue.len() {
+            let t = queue[i];
             i += 1;
             let tv = self.tets[t as usize];
             for f in 0..4 {
@@ -451,11 +477,14 @@ impl Triangulation {
                 let nb = self.neigh[4 * t as usize + f];
                 if nb != NONE && marks[(nb >> 2) as usize] != ep {
                     marks[(nb >> 2) as usize] = ep;
-                    out.push(nb >> 2);
+                    queue.push(nb >> 2);
+                    if stop(nb >> 2) {
+                        return Some(nb >> 2);
+                    }
                 }
             }
         }
-        out
+        None
     }
 
     /// The corners of face `4t+f`.
@@ -468,22 +497,20 @@ impl Triangulation {
     pub(crate) fn has_edge(&self, u: u32, v: u32) -> bool {
         // Not from a bounding corner, whose star holds the hull.
         let (u, v) = if u < 4 { (v, u) } else { (u, v) };
-        self.star(u)
-            .iter()
-            .any(|&t| self.tets[t as usize].contains(&v))
+        self.star_find(u, |t| self.tets[t as usize].contains(&v))
+            .is_some()
     }
 
     /// The tet face `4t+f` with corners `w` (any order), if it exists.
     pub fn find_face(&self, w: [u32; 3]) -> Option<u32> {
         let a = w.iter().copied().find(|&x| x >= 4).unwrap_or(w[0]);
-        for t in self.star(a) {
+        let t = self.star_find(a, |t| {
             let tv = self.tets[t as usize];
-            if w.iter().all(|x| tv.contains(x)) {
-                let f = (0..4).find(|&k| !w.contains(&tv[k])).unwrap();
-                return Some(4 * t + f as u32);
-            }
-        }
-        None
+            w.iter().all(|x| tv.contains(x))
+        })?;
+        let tv = self.tets[t as usize];
+        let f = (0..4).find(|&k| !w.contains(&tv[k])).unwrap();
+        Some(4 * t + f as u32)
     }
 }
 
