@@ -70,10 +70,19 @@ impl<'a> Front<'a> {
                 .collect();
             let pts = &self.pts;
             let n0 = pts.len() as u32;
-            let fills: Vec<_> = cavities
+            // Largest first, one cavity per task, so that the big ones
+            // start at once on different threads (one 1,560-face cavity
+            // takes as long as the rest together); applied in cavity
+            // order below, so the mesh does not depend on the threads.
+            let mut order: Vec<usize> = (0..cavities.len()).collect();
+            order.sort_by_key(|&i| std::cmp::Reverse(cavities[i].len()));
+            let mut done: Vec<(usize, _)> = order
                 .par_iter()
-                .map(|faces| fill_one(pts, faces, quick))
+                .with_max_len(1)
+                .map(|&i| (i, fill_one(pts, &cavities[i], quick)))
                 .collect();
+            done.sort_unstable_by_key(|d| d.0);
+            let fills = done.into_iter().map(|d| d.1);
             let mut failed: Vec<u32> = Vec::new();
             let mut closed = 0;
             for ((ids, faces), fill) in comps.iter().zip(&cavities).zip(fills) {
