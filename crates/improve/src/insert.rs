@@ -14,7 +14,7 @@
 //! with fewer tets under [`SMALL_DIHEDRAL`] and a min dihedral no lower; or, for
 //! a tet under [`LIFT_DEG`], when the cavity's min dihedral rises.
 use crate::ops::{positive, Cand, MARGIN};
-use crate::quality::{has_dihedral_under, min_dihedral_deg, quality};
+use crate::quality::{min_dihedral_deg, min_dihedral_deg_under, quality};
 use crate::work::{ring_tets, Work};
 use parafront_geom::{cross, dist2, norm, sub, P3};
 use parafront_mesh::quality::TET_EDGES;
@@ -186,11 +186,7 @@ impl Work<'_> {
             if !positive(x) {
                 return None;
             }
-            let d = if has_dihedral_under(x, tan_clamp) {
-                min_dihedral_deg(x)
-            } else {
-                clamp
-            };
+            let d = min_dihedral_deg_under(x, tan_clamp).unwrap_or(clamp);
             sc.add_angle(d);
             if bound.is_some_and(|b| cannot_beat(sc.key(old, lift), b)) {
                 return None;
@@ -602,6 +598,7 @@ impl Work<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::quality::has_dihedral_under;
 
     /// A tet the cheap test passes has its min dihedral at the clamp or
     /// above, so taking it as the clamp leaves every key as it was.

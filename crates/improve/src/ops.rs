@@ -6,7 +6,7 @@
 //! mesh and keeps it only when the worst quality of the tets it makes
 //! beats the worst of those it replaces, and every new tet is positive
 //! under the exact predicate and in floating point.
-use crate::quality::{has_dihedral_under, min_dihedral_deg, positive_quality, quality};
+use crate::quality::{min_dihedral_deg, min_dihedral_deg_under, positive_quality, quality};
 use crate::work::{ring_tets, Work, MAX_RING};
 use parafront_geom::{cross, dist2, norm, sub, P3};
 use parafront_mesh::{PointId, TET_FACES};
@@ -640,13 +640,15 @@ impl Work<'_> {
                     // A tet with no angle under 12.5° (the tangent test, no arc
                     // tangent) adds nothing to the count or the shortfall and
                     // passes a floor under 12°: only its sign matters.
-                    if fast && floor < 12.0 && !has_dihedral_under(x, crate::TAN_12_5) {
-                        if !positive(x) {
-                            return None;
+                    let d = if fast && floor < 12.0 {
+                        match min_dihedral_deg_under(x, crate::TAN_12_5) {
+                            Some(d) => d,
+                            None if !positive(x) => return None,
+                            None => continue,
                         }
-                        continue;
-                    }
-                    let d = min_dihedral_deg(x);
+                    } else {
+                        min_dihedral_deg(x)
+                    };
                     under += usize::from(d < crate::insert::SMALL_DIHEDRAL);
                     if under > cap || d < floor || !positive(x) {
                         return None;

@@ -52,12 +52,27 @@ const EDGE_SIDES: [[usize; 4]; 6] = [
 /// measure): the last polish, and the passes for the tets under 10° and
 /// for the worst ones, which work on the angles themselves.
 pub fn min_dihedral_deg(p: [P3; 4]) -> f64 {
+    let (e, m) = edges_and_normals(p);
+    min_dihedral_of(p, e, m)
+}
+
+/// `Some(min_dihedral_deg(p))` where [`has_dihedral_under`]`(p, tan_max)`,
+/// else `None`: the searches that only need the small angles, with the
+/// edges and normals computed once for both.
+pub fn min_dihedral_deg_under(p: [P3; 4], tan_max: f64) -> Option<f64> {
+    let (e, m) = edges_and_normals(p);
+    dihedral_under(&e, &m, tan_max).then(|| min_dihedral_of(p, e, m))
+}
+
+/// [`min_dihedral_deg`] from the tet's edges and normals.
+#[inline]
+fn min_dihedral_of(p: [P3; 4], e: [P3; 6], m: [P3; 4]) -> f64 {
     use parafront_geom::{cross, dot, norm};
     // One arc tangent, at the smallest angle's edge, instead of six (they
     // were a fifth of the improvement's time), and the four face normals
     // instead of two cross products per edge (this function was a third
     // of the tray's improvement, and is a sixth).
-    let Some(f) = Faces::new(p) else {
+    let Some(f) = Faces::new(e, m) else {
         return min_dihedral_slow(p);
     };
     // Every tet has an acute dihedral angle, and among acute ones the
@@ -94,8 +109,7 @@ struct Faces {
 impl Faces {
     /// `None` where a face has no normal (a flat or non-finite tet).
     #[inline]
-    fn new(p: [P3; 4]) -> Option<Faces> {
-        let (e, m) = edges_and_normals(p);
+    fn new(e: [P3; 6], m: [P3; 4]) -> Option<Faces> {
         let n2 = m.map(parafront_geom::norm2);
         if !n2.iter().all(|&x| x > 0.0 && x.is_finite()) {
             return None;
@@ -146,8 +160,14 @@ fn min_dihedral_slow(p: [P3; 4]) -> f64 {
 /// without the arc tangents. At the edge of faces `k` and `l`,
 /// `|m_k x m_l| = |e| |6V|`.
 pub fn has_dihedral_under(p: [P3; 4], tan_max: f64) -> bool {
-    use parafront_geom::{dot, norm2};
     let (e, m) = edges_and_normals(p);
+    dihedral_under(&e, &m, tan_max)
+}
+
+/// [`has_dihedral_under`] from the tet's edges and normals.
+#[inline]
+fn dihedral_under(e: &[P3; 6], m: &[P3; 4], tan_max: f64) -> bool {
+    use parafront_geom::{dot, norm2};
     let v6 = dot(e[0], m[1]);
     let t2 = tan_max * tan_max;
     // Squared: `|e|^2 (6V)^2 < tan^2 c12^2`, no square roots.
@@ -160,6 +180,25 @@ pub fn has_dihedral_under(p: [P3; 4], tan_max: f64) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The combined test gives what the two separate calls give, to the
+    /// bit, on regular, flattened, stretched and flat tets.
+    #[test]
+    fn min_dihedral_under_is_the_two_calls_in_one() {
+        let mut r = crate::test_rng(0xd1ed_d7a1);
+        let mut under = 0;
+        for i in 0..100_000 {
+            let squash = [1.0, 0.3, 0.05, 1e-3, 0.0][i % 5];
+            let p: [P3; 4] = std::array::from_fn(|_| [r(), r(), squash * r()]);
+            for tan in [0.176_326_980_708_464_98, 0.221_694_662_642_939_88, 1.0] {
+                let two = has_dihedral_under(p, tan).then(|| min_dihedral_deg(p));
+                let one = min_dihedral_deg_under(p, tan);
+                assert_eq!(one.map(f64::to_bits), two.map(f64::to_bits), "{p:?}");
+                under += usize::from(one.is_some());
+            }
+        }
+        assert!(under > 10_000, "{under}");
+    }
 
     #[test]
     fn is_the_mean_ratio() {
