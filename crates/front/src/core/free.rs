@@ -283,7 +283,22 @@ impl<'a> Front<'a> {
             if nsh == 0 && !tb.overlaps(&nf.bb) {
                 continue; // nothing in common with the tet, not even its box
             }
-            let apart = planes.separates(gp, gl, &d);
+            let mut apart = planes.separates(gp, gl, &d);
+            if !apart {
+                // The other way round: `g`'s plane with every tet corner
+                // off `g` strictly on one side (exact), so the tet meets
+                // `g` only in their common corners.
+                let mut pos = 0;
+                let mut neg = 0;
+                for j in 0..4 {
+                    if !g.contains(&tv[j]) {
+                        let o = parafront_geom::orient3d(gp[0], gp[1], gp[2], tp[j]);
+                        pos += usize::from(o > 0.0);
+                        neg += usize::from(o < 0.0);
+                    }
+                }
+                apart = pos + nsh == 4 || neg + nsh == 4;
+            }
             if apart && nsh < 2 {
                 continue; // no common edge: no matching face, no wedge
             }
