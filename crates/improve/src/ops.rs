@@ -6,7 +6,9 @@
 //! mesh and keeps it only when the worst quality of the tets it makes
 //! beats the worst of those it replaces, and every new tet is positive
 //! under the exact predicate and in floating point.
-use crate::quality::{min_dihedral_deg, min_dihedral_deg_under, positive_quality, quality};
+use crate::quality::{
+    min_dihedral_deg, min_dihedral_deg_under, positive_quality, quality, quality_over,
+};
 use crate::work::{ring_tets, Work, MAX_RING};
 use parafront_geom::{cross, dist2, norm, sub, P3};
 use parafront_mesh::{PointId, TET_FACES};
@@ -55,7 +57,13 @@ pub(crate) const MARGIN: f64 = 1e-3;
 
 #[inline]
 pub(crate) fn beats(new: f64, old: f64) -> bool {
-    new > old + MARGIN * old.abs() + 1e-12
+    new > bar(old)
+}
+
+/// What a quality must exceed to [`beats`] `old`.
+#[inline]
+pub(crate) fn bar(old: f64) -> f64 {
+    old + MARGIN * old.abs() + 1e-12
 }
 
 #[inline]
@@ -164,9 +172,10 @@ impl Work<'_> {
             return Outcome::Constrained;
         };
         let qold = self.q[t as usize].min(self.q[nt as usize]);
+        let qbar = bar(qold);
         let mut qmin = f64::INFINITY;
         for &nv in &new {
-            qmin = qmin.min(quality(self.pts(nv)));
+            qmin = qmin.min(quality_over(self.pts(nv), qbar));
             if !beats(qmin, qold) {
                 return Outcome::NotBetter; // first sign of worse (§9.1)
             }
@@ -196,6 +205,7 @@ impl Work<'_> {
         }
         let n = s.ring.len();
         let qold = self.ball_qmin(&s.tets);
+        let qbar = bar(qold);
         const N: usize = MAX_RING;
         s.tq.clear();
         s.tq.resize(N * N * N, f64::NAN);
@@ -216,9 +226,11 @@ impl Work<'_> {
                     }
                     let slot = &mut s.tq[(i * N + k) * N + j];
                     if slot.is_nan() {
-                        let q1 = quality([r[i], r[k], r[j], pb]);
+                        // A pair that cannot beat `qold` is scored -inf: no
+                        // choice below reads more of it than that.
+                        let q1 = quality_over([r[i], r[k], r[j], pb], qbar);
                         *slot = if beats(q1, qold) {
-                            q1.min(quality([r[i], r[j], r[k], pa]))
+                            q1.min(quality_over([r[i], r[j], r[k], pa], qbar))
                         } else {
                             q1
                         };
@@ -332,6 +344,7 @@ impl Work<'_> {
             }
         }
         let qold = self.ball_qmin(&s.ball);
+        let qbar = bar(qold);
         c.new.clear();
         let mut qmin = f64::INFINITY;
         for &t in &s.ball {
@@ -340,7 +353,7 @@ impl Work<'_> {
                 continue;
             }
             let nv = v.map(|x| if x == a { b } else { x });
-            qmin = qmin.min(quality(self.pts(nv)));
+            qmin = qmin.min(quality_over(self.pts(nv), qbar));
             if !beats(qmin, qold) {
                 return Outcome::NotBetter;
             }
