@@ -25,13 +25,13 @@ pub enum InsertError {
     Duplicate(P3, u32),
 }
 
-/// A tetrahedralization of a bounding tet: struct of arrays, `u32` ids,
-/// `neigh[4t+f] = 4u+g` (or [`NONE`] on the bounding tet's faces).
-///
 /// An edge's ring as [`Triangulation::edge_ring`] gave it: `(p, q,
 /// generation, tets, ring)`.
 pub(crate) type RingMemo = (u32, u32, u64, Vec<u32>, Vec<u32>);
 
+/// A tetrahedralization of a bounding tet: struct of arrays, `u32` ids,
+/// `neigh[4t+f] = 4u+g` (or [`NONE`] on the bounding tet's faces).
+///
 /// Points `0..4` are the bounding tet's corners; the points given to
 /// [`Triangulation::new`] follow in order. Dead tets keep their slot (their
 /// `alive` is false) and are reused.
@@ -49,8 +49,8 @@ pub struct Triangulation {
     conflict: Vec<u32>,
     pub(crate) mark: Vec<u32>,
     epoch: u32,
-    /// Scratch for [`Triangulation::star`]: a mark per tet slot and its
-    /// epoch.
+    /// Scratch for [`Triangulation::star`]: a mark per tet slot, its
+    /// epoch, and the walk's queue.
     star_mark: std::cell::RefCell<(Vec<u32>, u32, Vec<u32>)>,
     /// Bumped by every change of the tets, for the memo below.
     pub(crate) generation: u64,
@@ -442,7 +442,8 @@ impl Triangulation {
     /// The tets of [`Triangulation::star`], in its order, handed to `stop`
     /// until it returns true; that tet, or `None`. The searches of one face
     /// or edge stop at their first hit rather than build the whole star
-    /// (they were a sixth of a CAD cavity's fill).
+    /// (they were a sixth of a CAD cavity's fill). `stop` must not walk a
+    /// star itself (the scratch is borrowed).
     pub(crate) fn star_find(&self, v: u32, mut stop: impl FnMut(u32) -> bool) -> Option<u32> {
         let mut t0 = self.vtet[v as usize];
         if t0 == NONE || !self.alive[t0 as usize] || !self.tets[t0 as usize].contains(&v) {
