@@ -152,18 +152,13 @@ impl Triangulation {
         // (p, q, r0, r1) positive); a ring is short, so a list serves.
         let mut next: Vec<(u32, u32)> = Vec::with_capacity(tets.len());
         for &t in &tets {
-            let tv = self.tets[t as usize];
-            let mut o = [0u32; 2];
-            let mut k = 0;
-            for &v in &tv {
-                if v != p && v != q {
-                    o[k.min(1)] = v;
-                    k += 1;
-                }
-            }
-            if k != 2 {
-                return None; // p or q twice: not a tet on the edge
-            }
+            let mut others = self.tets[t as usize]
+                .into_iter()
+                .filter(|&v| v != p && v != q);
+            let (Some(o0), Some(o1)) = (others.next(), others.next()) else {
+                return None; // not a tet on the edge
+            };
+            let o = [o0, o1];
             let pts = [p, q, o[0], o[1]].map(|v| self.pts[v as usize]);
             let (r0, r1) = if orient3d(pts[0], pts[1], pts[2], pts[3]) > 0.0 {
                 (o[0], o[1])

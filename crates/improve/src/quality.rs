@@ -204,16 +204,25 @@ fn dihedral_under(e: &[P3; 6], m: &[P3; 4], tan_max: f64) -> bool {
 mod tests {
     use super::*;
 
+    /// Random tets, the `i`-th regular-ish, flattened, stretched or flat
+    /// by turns (the CAD parts' needles and slivers among them).
+    fn squashed_tets(seed: u64) -> impl FnMut(usize) -> [P3; 4] {
+        let mut r = crate::test_rng(seed);
+        move |i| {
+            let squash = [1.0, 0.3, 0.05, 1e-3, 0.0][i % 5];
+            std::array::from_fn(|_| [r(), r(), squash * r()])
+        }
+    }
+
     /// The cube-root-free bar: the quality itself, to the bit, or -inf
     /// only where the quality does not exceed the bar; and the bar test
     /// does skip most losers.
     #[test]
     fn quality_over_a_bar_is_the_quality_or_a_certain_loser() {
-        let mut r = crate::test_rng(0x0bad_ba12);
+        let mut tet = squashed_tets(0x0bad_ba12);
         let mut skipped = 0;
         for i in 0..100_000 {
-            let squash = [1.0, 0.3, 0.05, 1e-3, 0.0][i % 5];
-            let p: [P3; 4] = std::array::from_fn(|_| [r(), r(), squash * r()]);
+            let p = tet(i);
             let q = quality(p);
             // Bars near the quality too, where rounding would show.
             for bar in [-0.5, 0.0, 0.2, 0.7, q, q * (1.0 - 1e-12), q * (1.0 + 1e-12)] {
@@ -233,12 +242,11 @@ mod tests {
     /// bit, on regular, flattened, stretched and flat tets.
     #[test]
     fn min_dihedral_under_is_the_two_calls_in_one() {
-        let mut r = crate::test_rng(0xd1ed_d7a1);
+        let mut tet = squashed_tets(0xd1ed_d7a1);
         let mut under = 0;
         for i in 0..100_000 {
-            let squash = [1.0, 0.3, 0.05, 1e-3, 0.0][i % 5];
-            let p: [P3; 4] = std::array::from_fn(|_| [r(), r(), squash * r()]);
-            for tan in [0.176_326_980_708_464_98, 0.221_694_662_642_939_88, 1.0] {
+            let p = tet(i);
+            for tan in [crate::TAN_SMALL_DIHEDRAL, crate::TAN_12_5, 1.0] {
                 let two = has_dihedral_under(p, tan).then(|| min_dihedral_deg(p));
                 let one = min_dihedral_deg_under(p, tan);
                 assert_eq!(one.map(f64::to_bits), two.map(f64::to_bits), "{p:?}");

@@ -290,9 +290,9 @@ impl<'a> Front<'a> {
                 // `g` only in their common corners.
                 let mut pos = 0;
                 let mut neg = 0;
-                for j in 0..4 {
-                    if !g.contains(&tv[j]) {
-                        let o = parafront_geom::orient3d(gp[0], gp[1], gp[2], tp[j]);
+                for (j, &x) in tp.iter().enumerate() {
+                    if !gl.contains(&j) {
+                        let o = parafront_geom::orient3d(gp[0], gp[1], gp[2], x);
                         pos += usize::from(o > 0.0);
                         neg += usize::from(o < 0.0);
                     }
