@@ -130,6 +130,17 @@ pub(crate) fn print_summary(sum: &Summary) {
             sum.fill_tets
         );
     }
+    if !sum.regions_refined.is_empty() {
+        let s = if sum.regions_refined.len() == 1 {
+            ""
+        } else {
+            "s"
+        };
+        println!(
+            "region{s} {:?}: the front stalled on much of the surface, so the constrained fill of the whole surface, refined to the size field (GDT), meshed it",
+            sum.regions_refined
+        );
+    }
     if !sum.regions_filled.is_empty() {
         println!(
             "warning: the front could not close region{} {:?}: filled whole by the constrained Delaunay fill of its surface, refined to the size field (GDT: valid, but not the front's quality)",

@@ -678,6 +678,9 @@ fn serial_region(
     sum.tets_removed += res.stats.tets_removed;
     sum.cavities_filled += res.stats.cavities_filled;
     sum.fill_tets += res.stats.fill_tets;
+    if res.stats.regions_refined > 0 {
+        sum.regions_refined.push(region);
+    }
     Ok(())
 }
 

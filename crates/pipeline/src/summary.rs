@@ -120,6 +120,10 @@ pub struct Summary {
     /// field by Delaunay insertion: valid, without the front's quality.
     /// Ids as in `Front` errors.
     pub regions_filled: Vec<usize>,
+    /// Regions whose front stalled on much of their surface at its first
+    /// stall, and that the fill of their whole surface, refined to the
+    /// size field (GDT), meshed instead. Ids as in `Front` errors.
+    pub regions_refined: Vec<usize>,
     /// Shells (ids as `parafront check` prints them) oriented as inner
     /// bodies and meshed as voids, without `regions`.
     pub voided_shells: Vec<usize>,

@@ -193,3 +193,59 @@ proptest! {
         meshes_at("tower", &twisted_tower(&twists, height), &[None]);
     }
 }
+
+/// A CAD part (the angle block, healed; its needle triangles come from a
+/// plane at y = 0 whose vertices lie up to 4e-17 off it) whose front, at
+/// its first stall, leaves the fill two cavities it cannot close that hold
+/// more faces than the surface: the region's whole surface is filled and
+/// refined to the size field instead (GDT), without a recovery round. The
+/// mesh keeps the surface, fills it exactly, has points inside (the
+/// refinement's), and is the same on one thread and on two. The hinge,
+/// whose first-stall cavities all close, keeps its front's tets.
+#[test]
+fn a_region_the_fill_cannot_close_in_pieces_is_filled_whole_and_refined() {
+    use parafront_surface::read::{read_surface_bytes, Format};
+    let text = include_str!("data/angle_block_healed.obj");
+    let s =
+        read_surface_bytes("angle_block_healed.obj", text.as_bytes(), Format::Obj).expect("OBJ");
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .expect("pool");
+        pool.install(|| mesh_surface(&s, &MeshOptions::default()))
+            .expect("the angle block meshes")
+    };
+    let (m, sum) = run(1);
+    m.check_against_surface(&s.tris).expect("valid");
+    let v = s.signed_volume();
+    assert!(
+        (m.volume() - v).abs() <= 1e-9 * v,
+        "volume {} of {v}",
+        m.volume()
+    );
+    assert_eq!(sum.regions_refined, vec![1], "{sum:?}");
+    assert_eq!(sum.recovery_rounds, 0, "{sum:?}");
+    assert!(sum.regions_filled.is_empty(), "{sum:?}");
+    // The fill alone adds a few dozen split points (39); the refinement
+    // brings the interior to the size field.
+    assert!(
+        m.points.len() > s.points.len() + 400,
+        "{} points for {} on the surface",
+        m.points.len(),
+        s.points.len()
+    );
+    let (m2, _) = run(2);
+    assert_eq!(m.tets, m2.tets, "the same mesh on two threads");
+    assert_eq!(m.points, m2.points);
+
+    let text = include_str!("../../delaunay/tests/data/hinge_surface.obj");
+    // Its faces point inward, as the delaunay crate's fills take them.
+    let hinge = read_surface_bytes("hinge.obj", text.as_bytes(), Format::Obj)
+        .expect("OBJ")
+        .flipped();
+    let (m, sum) = mesh_surface(&hinge, &MeshOptions::default()).expect("the hinge meshes");
+    m.check_against_surface(&hinge.tris).expect("valid");
+    assert!(sum.regions_refined.is_empty(), "{sum:?}");
+    assert!(sum.cavities_filled > 0, "{sum:?}");
+}

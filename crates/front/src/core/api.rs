@@ -108,6 +108,9 @@ pub struct FrontStats {
     pub cavities_filled: usize,
     /// Tets the constrained Delaunay fill made.
     pub fill_tets: usize,
+    /// Regions whose whole surface the fill closed and refined to the
+    /// size field (GDT, §2) in place of the front (0 or 1 for one front).
+    pub regions_refined: usize,
 }
 
 /// What the front made.

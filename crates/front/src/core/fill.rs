@@ -47,6 +47,21 @@ fn fill_one(
     fill.or_else(|_| fill_cavity(pts, faces, &FillOptions::default()))
 }
 
+/// Whether a fill's tets, over `pts` then `steiner`, have one flat in
+/// floating point.
+fn any_flat(pts: &[P3], steiner: &[P3], tets: &[[u32; 4]]) -> bool {
+    let n = pts.len();
+    let at = |v: u32| {
+        let v = v as usize;
+        if v < n {
+            pts[v]
+        } else {
+            steiner[v - n]
+        }
+    };
+    tets.iter().any(|t| parafront_delaunay::is_flat(t.map(at)))
+}
+
 impl<'a> Front<'a> {
     /// Fill every cavity of the live front; `false` when one is left after
     /// `growth` growth rounds. `quick`: only the conforming fill.
@@ -140,33 +155,37 @@ impl<'a> Front<'a> {
             faces = faces.len(),
             "front stalled at once: constrained fill of the region"
         );
-        let fill = match fill_cavity(&self.pts, &faces, &fopts) {
-            Ok(f) => f,
-            Err(e) => {
-                tracing::debug!(error = %e, "region not filled");
-                return false;
-            }
-        };
-        // Exactly positive is valid; a tet flat in floating point (a split
-        // point moved a hair off the surface, four corners on one CAD
-        // plane) would be the improvement's to undo, and the front's tets
-        // serve better.
-        let n = self.pts.len();
-        let at = |v: u32| {
-            let v = v as usize;
-            if v < n {
-                self.pts[v]
-            } else {
-                fill.steiner[v - n]
-            }
-        };
-        if fill.tets.iter().any(|t| {
-            let p = t.map(at);
-            parafront_delaunay::is_flat(p)
-        }) {
-            tracing::debug!("region fill has a tet flat in floating point");
+        let Some(fill) = self.whole_fill(&faces, &fopts) else {
             return false;
+        };
+        let n = self.pts.len() as u32;
+        self.take_whole(&faces, fill, n);
+        true
+    }
+
+    /// The fill of the whole input `faces`, unless it fails or has a tet
+    /// flat in floating point: exactly positive is valid, but such a tet (a
+    /// split point moved a hair off the surface, four corners on one CAD
+    /// plane) would be the improvement's to undo, and the front's tets
+    /// serve better.
+    fn whole_fill(
+        &self,
+        faces: &[[u32; 3]],
+        fopts: &FillOptions,
+    ) -> Option<parafront_delaunay::Fill> {
+        let fill = fill_cavity(&self.pts, faces, fopts)
+            .map_err(|e| tracing::debug!(error = %e, "region not filled"))
+            .ok()?;
+        if any_flat(&self.pts, &fill.steiner, &fill.tets) {
+            tracing::debug!("region fill has a tet flat in floating point");
+            return None;
         }
+        Some(fill)
+    }
+
+    /// Every tet the front made gives way to `fill`, a fill of its whole
+    /// input `faces` whose Steiner points are numbered from `n`.
+    fn take_whole(&mut self, faces: &[[u32; 3]], fill: parafront_delaunay::Fill, n: u32) {
         if let Some(p) = &self.opts.progress {
             p.note_fill();
         }
@@ -174,10 +193,67 @@ impl<'a> Front<'a> {
             .filter(|&t| self.talive[t as usize])
             .collect();
         self.remove_tets(&live);
-        self.apply_fill(&faces, fill, n as u32);
+        self.apply_fill(faces, fill, n);
         self.stuck.clear();
         self.heap.clear();
         self.prohibited.clear();
+    }
+
+    /// The region's whole input surface filled (its edges split first, the
+    /// splits bounded as a cavity's) and refined to the size field by
+    /// Delaunay insertion: GDT (§2) in place of the front, for a region
+    /// whose first stall left cavities the fill could not close on much of
+    /// it. On success every tet the front made gives way to it; `false`
+    /// leaves the front as it was.
+    pub(super) fn fill_region(&mut self) -> bool {
+        let SizeMode::Field(size) = self.size else {
+            return false;
+        };
+        let faces = std::mem::take(&mut self.region0);
+        if faces.is_empty() {
+            return false;
+        }
+        tracing::debug!(
+            faces = faces.len(),
+            "front stalled on much of the region: constrained fill of the region, refined"
+        );
+        let fopts = FillOptions {
+            segments_first: true,
+            max_split: ((faces.len() as f64 * SPLITS_PER_FACE) as usize).max(MIN_SPLITS),
+            headway_rounds: HEADWAY_ROUNDS,
+            ..FillOptions::default()
+        };
+        let Some(fill) = self.whole_fill(&faces, &fopts) else {
+            return false;
+        };
+        let n = self.pts.len();
+        let mut all = self.pts.clone();
+        all.extend_from_slice(&fill.steiner);
+        let refined = match parafront_delaunay::refine_to_size(
+            &all,
+            &fill.tets,
+            &[],
+            size,
+            &parafront_delaunay::RefineOptions::default(),
+        ) {
+            Ok(r) => r,
+            Err(e) => {
+                tracing::debug!(error = %e, "region fill not refined");
+                return false;
+            }
+        };
+        let mut steiner = fill.steiner;
+        steiner.extend_from_slice(&refined.points);
+        let fill = parafront_delaunay::Fill {
+            steiner,
+            tets: refined.tets,
+            ..fill
+        };
+        // The region is one cavity now: the fills before it gave way.
+        self.stats.cavities_filled = 0;
+        self.stats.fill_tets = 0;
+        self.take_whole(&faces, fill, n as u32);
+        self.stats.regions_refined += 1;
         true
     }
 

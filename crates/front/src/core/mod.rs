@@ -83,6 +83,15 @@ const FILL_TRIES: u32 = 1;
 /// milliseconds and the fill's tets are not the front's.
 const STALL_FILL_SHARE: f64 = 0.25;
 
+/// A first stall whose cavities the fill leaves open on at least this
+/// share of the input faces' count hands the region's whole surface to the
+/// fill, refined to the size field ([`Front::fill_region`], GDT's start):
+/// the angle block's two open cavities hold 774 faces for its 704, and
+/// cost four recovery rounds and a fill (3.1 s) where its whole surface
+/// fills in 0.14 s; the idler's open cavity, 402 for 1,572, goes on to
+/// recovery (0.9 s), its whole surface's fill failing in 1.4 s.
+const REGION_FILL_SHARE: f64 = 0.5;
+
 /// A front that stalls for the first time with fewer tets than this many
 /// per input face hands its whole region to the fill
 /// ([`Front::fill_early`]): round.stl stalls at 76 tets for 1,120 faces,
@@ -216,6 +225,9 @@ struct Front<'a> {
     /// The input front, kept while the first stall may still hand it
     /// whole to the fill ([`EARLY_FILL_TETS`]).
     input0: Vec<[u32; 3]>,
+    /// The input front again, kept until the first stall, which may hand
+    /// it whole to the fill and the refinement ([`REGION_FILL_SHARE`]).
+    region0: Vec<[u32; 3]>,
     /// Faces of the input front.
     n_input_faces: usize,
     opts: &'a FrontOptions,
@@ -359,6 +371,7 @@ impl<'a> Front<'a> {
             new_at: Vec::new(),
             relax: 0,
             input0: Vec::new(),
+            region0: Vec::new(),
             n_input_faces: input.faces.len(),
             opts,
             region,
@@ -380,6 +393,9 @@ impl<'a> Front<'a> {
             f.add_face(v, NONE);
         }
         if opts.fill && opts.fill_early && !opts.pass && input.faces.len() >= EARLY_FILL_MIN_FACES {
+            if opts.fill_at_stall && matches!(size, SizeMode::Field(_)) {
+                f.region0.clone_from(&input.faces);
+            }
             f.input0 = input.faces;
         }
         f
@@ -546,11 +562,21 @@ impl<'a> Front<'a> {
                 && self.opts.fill_at_stall
                 && !self.opts.pass
                 && self.stuck.len() as f64 >= STALL_FILL_SHARE * self.n_input_faces as f64
-                && self.fill_stalled(0, true)
             {
-                continue;
+                if self.fill_stalled(0, true) {
+                    continue;
+                }
+                // The cavities it left hold much of the region: the
+                // region's own surface, filled and refined, costs less than
+                // their recovery.
+                if self.stuck.len() as f64 >= REGION_FILL_SHARE * self.n_input_faces as f64
+                    && self.fill_region()
+                {
+                    continue;
+                }
             }
             self.input0 = Vec::new();
+            self.region0 = Vec::new();
             self.recover();
             debug_assert_eq!(self.check(), Ok(()), "after recovery round {}", self.relax);
         }
@@ -592,7 +618,7 @@ impl<'a> Front<'a> {
     fn finish(self) -> FrontResult {
         // The search structures go first: the output is built in place, so
         // the peak is the front's own.
-        drop((self.heap, self.fmap, self.fgrid));
+        drop((self.heap, self.fmap, self.fgrid, self.input0, self.region0));
         drop((self.near_f, self.near_p, self.cands, self.stamp, self.stuck));
         let front: Vec<[u32; 3]> = self
             .prohibited
