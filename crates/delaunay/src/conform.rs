@@ -373,8 +373,11 @@ fn between(chains: &Chains, a: u32, x: u32, c: u32) -> bool {
 }
 
 /// Points on one cavity edge (rounding may leave them not quite in line).
+/// Only a split edge holds three points.
 pub(crate) fn one_chain(chains: &Chains, w: [u32; 3]) -> bool {
-    chains.values().any(|c| w.iter().all(|v| c.contains(v)))
+    chains
+        .values()
+        .any(|c| c.len() >= 3 && w.iter().all(|v| c.contains(v)))
 }
 
 pub(crate) fn tri_normal_of(pts: &[P3], f: [u32; 3]) -> P3 {
