@@ -27,6 +27,7 @@
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
+mod batch;
 mod insert;
 mod ops;
 pub mod parallel;
@@ -305,6 +306,7 @@ pub struct Improver<'m> {
     ins: insert::InsScratch,
     c: Cand,
     best: Cand,
+    batch: batch::Batch,
 }
 
 impl<'m> Improver<'m> {
@@ -319,6 +321,7 @@ impl<'m> Improver<'m> {
             ins: Default::default(),
             c: Cand::default(),
             best: Cand::default(),
+            batch: Default::default(),
         })
     }
 
@@ -415,18 +418,22 @@ impl<'m> Improver<'m> {
     /// [`Improver::insert_point`] with the min dihedral to aim at first.
     fn insert_with(&mut self, t: u32, lift: Option<f64>) -> Outcome {
         match self.w.eval_insert(t, lift, &mut self.ins, &mut self.best) {
-            Ok(pos) => {
-                let p = self.w.push_point(pos);
-                let ok = self.commit();
-                debug_assert!(ok, "a star did not fit its cavity");
-                if !ok {
-                    self.remove_point(p);
-                    return Outcome::Inverted;
-                }
-                Outcome::Done
-            }
+            Ok(pos) => self.commit_insert(pos),
             Err(o) => o,
         }
+    }
+
+    /// Adds the point at `pos` and commits `self.best`, whose star names
+    /// the new point by the next id.
+    fn commit_insert(&mut self, pos: P3) -> Outcome {
+        let p = self.w.push_point(pos);
+        let ok = self.commit();
+        debug_assert!(ok, "a star did not fit its cavity");
+        if !ok {
+            self.remove_point(p);
+            return Outcome::Inverted;
+        }
+        Outcome::Done
     }
 
     /// The best face swap or edge removal around tet `t` for the

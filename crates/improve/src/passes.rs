@@ -2,6 +2,7 @@
 //! operation is tried on, in which order, and how often; the operations
 //! themselves are in `ops.rs` and `insert.rs`.
 use super::*;
+use rayon::prelude::*;
 
 impl Improver<'_> {
     /// What follows the last dihedral polish on a whole mesh (parts leave
@@ -95,19 +96,43 @@ impl Improver<'_> {
                 break; // none under 10°, so none under 0.1°
             }
             let mut changed = 0;
-            for (d0, t) in bad {
-                if !self.unchanged(t, d0) || (!lift && self.w.tested[t as usize]) {
-                    continue;
-                }
-                st.insert.tried += 1;
-                if self.insert_point(t, lift) == Outcome::Done {
-                    st.insert.done += 1;
-                    st.points_inserted += 1;
-                    changed += 1;
-                } else if !lift {
-                    self.w.tested[t as usize] = true;
+            // In batches of tets far apart, each evaluated at once (the
+            // insertion's search is most of the improvement's time on CAD
+            // parts) and committed in order.
+            let mut b = std::mem::take(&mut self.batch);
+            let mut pending = bad;
+            while !pending.is_empty() {
+                self.next_batch(&mut b, &mut pending, |s, d0, t| {
+                    s.unchanged(t, d0) && (lift || !s.w.tested[t as usize])
+                });
+                let found = self.eval_inserts(&b.tets, lift);
+                let next = PointId::new(self.w.m.points.len());
+                for (&t, r) in b.tets.iter().zip(found) {
+                    st.insert.tried += 1;
+                    let o = match r {
+                        Ok((pos, mut c)) => {
+                            // Each commit's point takes the next id.
+                            let p = PointId::new(self.w.m.points.len());
+                            c.new.iter_mut().flatten().for_each(|v| {
+                                if *v == next {
+                                    *v = p;
+                                }
+                            });
+                            self.best = c;
+                            self.commit_insert(pos)
+                        }
+                        Err(o) => o,
+                    };
+                    if o == Outcome::Done {
+                        st.insert.done += 1;
+                        st.points_inserted += 1;
+                        changed += 1;
+                    } else if !lift {
+                        self.w.tested[t as usize] = true;
+                    }
                 }
             }
+            self.batch = b;
             // Plain rounds stop when nothing changes.
             round = if changed == 0 && round < INSERT_ROUNDS {
                 INSERT_ROUNDS
@@ -134,6 +159,31 @@ impl Improver<'_> {
         self.count_pass(st);
         self.count_swap_pass(st);
         self.count_pass(st);
+    }
+
+    /// [`Work::eval_insert`] on each of `tets` (a batch: far apart), at
+    /// once; `lift` as [`Improver::insert_point`] takes it.
+    fn eval_inserts(&self, tets: &[u32], lift: bool) -> Vec<Result<(P3, Cand), Outcome>> {
+        let w = &self.w;
+        tets.par_iter()
+            .map_init(
+                || (insert::InsScratch::default(), Cand::default()),
+                |(s, c), &t| {
+                    let lift = (lift
+                        && quality::min_dihedral_deg(w.pts(w.m.tets[t as usize]))
+                            < insert::LIFT_DEG)
+                        .then_some(insert::LIFT_GOAL);
+                    w.eval_insert(t, lift, s, c).map(|pos| {
+                        let out = Cand {
+                            old: c.old.clone(),
+                            new: c.new.clone(),
+                            qmin: c.qmin,
+                        };
+                        (pos, out)
+                    })
+                },
+            )
+            .collect()
     }
 
     /// Swaps around the tets under 10° that leave fewer of them
