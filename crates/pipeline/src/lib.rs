@@ -592,71 +592,65 @@ fn serial_region(
     lattice_inner: &mut Vec<u32>,
 ) -> Result<(), MeshError> {
     let field = |p| sizing.size(p);
-    let (mut points, mut point_size) = region_points(s, sizing, rf);
-    let mut faces = rf.faces.clone();
+    let (points, point_size) = region_points(s, sizing, rf);
     // §2's optimal space-filling tets: the lattice's points follow the
     // surface's, its outer faces join the initial front.
     let n_in = points.len() as u32;
     let lattice = region_lattice(&points, &point_size, rf, sizing, opts, sum);
-    points.extend_from_slice(&lattice.points);
-    point_size.extend_from_slice(&lattice.size);
-    faces.extend(lattice.faces.iter().map(|f| f.map(|v| v + n_in)));
-    let input = FrontInput {
-        points,
-        point_size,
-        faces,
+    let with_lattice = |(mut points, mut point_size): (Vec<parafront_geom::P3>, Vec<f64>)| {
+        points.extend_from_slice(&lattice.points);
+        point_size.extend_from_slice(&lattice.size);
+        let mut faces = rf.faces.clone();
+        faces.extend(lattice.faces.iter().map(|f| f.map(|v| v + n_in)));
+        FrontInput {
+            points,
+            point_size,
+            faces,
+        }
     };
-    let res = advance(
-        input,
-        SizeMode::Field(&field),
-        &parafront_front::Everywhere,
-        &FrontOptions {
-            progress: opts.progress.clone(),
-            keep_partial: opts.debug_partial,
-            fill_after: opts.fill_after,
-            fill_early: true,
-            ..FrontOptions::default()
-        },
-    );
+    let mut input = Some(with_lattice((points, point_size)));
     let region = rf.region_id as usize;
+    // With a lattice (§2), a region the front stalls on at once is handed
+    // back rather than filled in the front: its whole surface is filled
+    // here, the lattice's points seeding the refinement; where that fails,
+    // the front runs again and fills or recovers in place.
+    let mut hand_over = !lattice.faces.is_empty();
+    let res = loop {
+        let input = input
+            .take()
+            .unwrap_or_else(|| with_lattice(region_points(s, sizing, rf)));
+        let res = advance(
+            input,
+            SizeMode::Field(&field),
+            &parafront_front::Everywhere,
+            &FrontOptions {
+                progress: opts.progress.clone(),
+                keep_partial: opts.debug_partial,
+                fill_after: opts.fill_after,
+                fill_early: true,
+                hand_over,
+                ..FrontOptions::default()
+            },
+        );
+        if !matches!(res, Err(FrontError::HandOver)) {
+            break res;
+        }
+        if let Some((all, tets)) = fill_whole(s, sizing, rf, &lattice.points) {
+            append_region(mesh, rf, &all, &tets);
+            sum.regions_refined.push(region);
+            sum.fill_tets += tets.len();
+            return Ok(());
+        }
+        hand_over = false;
+    };
     let res = match res {
         Ok(r) => r,
         // The front could not close the region: the constrained fill of its
         // whole surface, refined to the size field by Delaunay insertion
         // (GDT, §2), unless a debug dump was asked for.
         Err(e @ FrontError::Stuck { .. }) if !opts.debug_partial => {
-            // The front took the points; this path is rare, so they are
-            // gathered again rather than copied on every run.
-            let (points, _) = region_points(s, sizing, rf);
-            let fill = parafront_delaunay::fill_cavity(
-                &points,
-                &rf.faces,
-                &parafront_delaunay::FillOptions {
-                    segments_first: true,
-                    ..Default::default()
-                },
-            )
-            .map_err(|_| MeshError::Front { region, source: e })?;
-            let mut all = points;
-            all.extend_from_slice(&fill.steiner);
-            // The fill is valid, so refinement takes it; were it not, the
-            // fill as it is still is a mesh.
-            // The region's lattice (§2), where it has one, seeds it.
-            let tets = match parafront_delaunay::refine_to_size(
-                &all,
-                &fill.tets,
-                &lattice.points,
-                &field,
-                &parafront_delaunay::RefineOptions::default(),
-            ) {
-                Ok(r) => {
-                    all.extend_from_slice(&r.points);
-                    r.tets
-                }
-                Err(err) => {
-                    tracing::warn!(region, %err, "the region's fill was not refined");
-                    fill.tets
-                }
+            let Some((all, tets)) = fill_whole(s, sizing, rf, &lattice.points) else {
+                return Err(MeshError::Front { region, source: e });
             };
             tracing::warn!(
                 region,
@@ -682,6 +676,49 @@ fn serial_region(
         sum.regions_refined.push(region);
     }
     Ok(())
+}
+
+/// Region `rf`'s whole surface filled by the constrained fill, refined to
+/// the size field by Delaunay insertion (GDT, §2; `seeds`, a lattice's
+/// points, go in first): its points and tets, or `None` where the fill
+/// fails. The fill is valid, so refinement takes it; were it not, the fill
+/// as it is still is a mesh.
+fn fill_whole(
+    s: &Surface,
+    sizing: &Sizing,
+    rf: &RegionFront,
+    seeds: &[parafront_geom::P3],
+) -> Option<(Vec<parafront_geom::P3>, Vec<[u32; 4]>)> {
+    let field = |p| sizing.size(p);
+    let (points, _) = region_points(s, sizing, rf);
+    let fill = parafront_delaunay::fill_cavity(
+        &points,
+        &rf.faces,
+        &parafront_delaunay::FillOptions {
+            segments_first: true,
+            ..Default::default()
+        },
+    )
+    .ok()?;
+    let mut all = points;
+    all.extend_from_slice(&fill.steiner);
+    let tets = match parafront_delaunay::refine_to_size(
+        &all,
+        &fill.tets,
+        seeds,
+        &field,
+        &parafront_delaunay::RefineOptions::default(),
+    ) {
+        Ok(r) => {
+            all.extend_from_slice(&r.points);
+            r.tets
+        }
+        Err(err) => {
+            tracing::warn!(region = rf.region_id, %err, "the region's fill was not refined");
+            fill.tets
+        }
+    };
+    Some((all, tets))
 }
 
 /// §2's optimal space-filling tets in region `rf` (its surface points

@@ -4,6 +4,7 @@
 //! and fill it exactly.
 use parafront_pipeline::{mesh_surface, MeshOptions};
 use parafront_surface::hard::{boss_box, frustum, rod, slotted_box, twisted_tower};
+use parafront_surface::read::{read_surface_bytes, Format};
 use parafront_surface::Surface;
 use proptest::prelude::*;
 
@@ -194,6 +195,23 @@ proptest! {
     }
 }
 
+/// The angle block of trimesh's models, healed (see the file's header).
+fn angle_block() -> Surface {
+    let text = include_str!("data/angle_block_healed.obj");
+    read_surface_bytes("angle_block_healed.obj", text.as_bytes(), Format::Obj).expect("OBJ")
+}
+
+/// `m` keeps `s`'s triangles and fills its volume exactly.
+fn fills_exactly(m: &parafront_mesh::TetMesh, s: &Surface) {
+    m.check_against_surface(&s.tris).expect("valid");
+    let v = s.signed_volume();
+    assert!(
+        (m.volume() - v).abs() <= 1e-9 * v,
+        "volume {} of {v}",
+        m.volume()
+    );
+}
+
 /// A CAD part (the angle block, healed; its needle triangles come from a
 /// plane at y = 0 whose vertices lie up to 4e-17 off it) whose front, at
 /// its first stall, leaves the fill two cavities it cannot close that hold
@@ -204,10 +222,7 @@ proptest! {
 /// whose first-stall cavities all close, keeps its front's tets.
 #[test]
 fn a_region_the_fill_cannot_close_in_pieces_is_filled_whole_and_refined() {
-    use parafront_surface::read::{read_surface_bytes, Format};
-    let text = include_str!("data/angle_block_healed.obj");
-    let s =
-        read_surface_bytes("angle_block_healed.obj", text.as_bytes(), Format::Obj).expect("OBJ");
+    let s = angle_block();
     let run = |threads: usize| {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
@@ -217,13 +232,7 @@ fn a_region_the_fill_cannot_close_in_pieces_is_filled_whole_and_refined() {
             .expect("the angle block meshes")
     };
     let (m, sum) = run(1);
-    m.check_against_surface(&s.tris).expect("valid");
-    let v = s.signed_volume();
-    assert!(
-        (m.volume() - v).abs() <= 1e-9 * v,
-        "volume {} of {v}",
-        m.volume()
-    );
+    fills_exactly(&m, &s);
     assert_eq!(sum.regions_refined, vec![1], "{sum:?}");
     assert_eq!(sum.recovery_rounds, 0, "{sum:?}");
     assert!(sum.regions_filled.is_empty(), "{sum:?}");
@@ -248,4 +257,28 @@ fn a_region_the_fill_cannot_close_in_pieces_is_filled_whole_and_refined() {
     m.check_against_surface(&hinge.tris).expect("valid");
     assert!(sum.regions_refined.is_empty(), "{sum:?}");
     assert!(sum.cavities_filled > 0, "{sum:?}");
+}
+
+/// The angle block under a given size, so with a lattice (§2) in its
+/// front's input: the first stall's open cavities hand the region back to
+/// the pipeline, which fills its surface whole with the lattice's points
+/// as seeds (the lattice's own tets give way); without the lattice the
+/// front fills it in place. Both meshes keep the surface and fill the
+/// volume exactly, and neither takes the warning's path.
+#[test]
+fn a_region_with_a_lattice_is_handed_back_and_filled_whole() {
+    use parafront_pipeline::LatticeMode;
+    let s = angle_block();
+    for lattice in [LatticeMode::On, LatticeMode::Off] {
+        let mut o = MeshOptions {
+            lattice,
+            ..MeshOptions::default()
+        };
+        o.size.h = Some(0.1);
+        let (m, sum) = mesh_surface(&s, &o).expect("the angle block meshes");
+        fills_exactly(&m, &s);
+        assert_eq!(sum.regions_refined, vec![1], "{lattice:?}: {sum:?}");
+        assert!(sum.regions_filled.is_empty(), "{lattice:?}: {sum:?}");
+        assert_eq!(sum.lattice_tets, 0, "{lattice:?}: the lattice gave way");
+    }
 }

@@ -49,6 +49,11 @@ pub struct FrontOptions {
     /// (edges split first); where that fails, recovery goes on. For a
     /// region's surface; a gap left by the passes (§7) is thin by nature.
     pub fill_early: bool,
+    /// Where the first stall's fill leaves cavities on much of the region
+    /// (`REGION_FILL_SHARE`), return [`FrontError::HandOver`] instead of
+    /// filling the input whole here: for an input that holds a lattice
+    /// (§2), whose tets the caller adds.
+    pub hand_over: bool,
     /// At the front's first stall, when it leaves many faces stuck, fill
     /// the cavities (no growth rounds) before any recovery round; those
     /// the fill cannot close go on to recovery. Not in a parallel pass
@@ -71,6 +76,7 @@ impl Default for FrontOptions {
             fill_growth: 4,
             fill_after: DEFAULT_FILL_AFTER,
             fill_early: false,
+            hand_over: false,
             fill_at_stall: true,
         }
     }
@@ -181,4 +187,10 @@ pub enum FrontError {
     /// field or a front running away.
     #[error("more than {0} points: the size field or the front is running away")]
     TooManyPoints(usize),
+    /// With `FrontOptions::hand_over`: the first stall left cavities on
+    /// much of the region, which its surface's whole fill, refined, would
+    /// mesh better; the input holds a lattice whose tets are the caller's,
+    /// so the caller fills the surface (the lattice's points as seeds).
+    #[error("the front stalled on much of the region: its surface is to be filled whole")]
+    HandOver,
 }

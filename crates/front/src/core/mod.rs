@@ -570,9 +570,14 @@ impl<'a> Front<'a> {
                 // region's own surface, filled and refined, costs less than
                 // their recovery.
                 if self.stuck.len() as f64 >= REGION_FILL_SHARE * self.n_input_faces as f64
-                    && self.fill_region()
+                    && !self.region0.is_empty()
                 {
-                    continue;
+                    if self.opts.hand_over {
+                        return Err(FrontError::HandOver);
+                    }
+                    if self.fill_region() {
+                        continue;
+                    }
                 }
             }
             self.input0 = Vec::new();
