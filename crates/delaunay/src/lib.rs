@@ -47,5 +47,5 @@ pub use check::CheckError;
 pub use fill::{fill_cavity, Fill, FillError, FillMethod, FillOptions};
 pub use flips::Flip;
 pub use predicates::{is_flat, FLAT};
-pub use refine::{refine_to_size, RefineError, RefineOptions, Refined};
+pub use refine::{refine_fill, refine_to_size, RefineError, RefineOptions, Refined};
 pub use tri::{InsertError, Triangulation, NONE, TET_FACES};

@@ -6,6 +6,7 @@
 //! the surface keeps every triangle and no point goes on it. A point
 //! outside the region, or closer than half a size to a point of its
 //! cavity, is not inserted (the spacing bounds the points, so it ends).
+use crate::fill::Fill;
 use crate::flips::key3;
 use crate::tri::{Triangulation, NONE, TET_FACES};
 use parafront_geom::{add, cross, dist, dist2, dot, orient3d, scale, sub, P3};
@@ -117,6 +118,28 @@ pub fn refine_to_size(
         points: new,
         tets: out,
         capped,
+    })
+}
+
+/// [`refine_to_size`] of a cavity's fill over `points` (its Steiner points
+/// numbered after them): the fill again, its Steiner points followed by
+/// the refinement's.
+pub fn refine_fill(
+    points: &[P3],
+    fill: &Fill,
+    seeds: &[P3],
+    size: &(dyn Fn(P3) -> f64 + Sync),
+    opts: &RefineOptions,
+) -> Result<Fill, RefineError> {
+    let mut all = points.to_vec();
+    all.extend_from_slice(&fill.steiner);
+    let r = refine_to_size(&all, &fill.tets, seeds, size, opts)?;
+    let mut steiner = fill.steiner.clone();
+    steiner.extend_from_slice(&r.points);
+    Ok(Fill {
+        steiner,
+        tets: r.tets,
+        ..*fill
     })
 }
 

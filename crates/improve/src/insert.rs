@@ -266,6 +266,14 @@ impl Work<'_> {
         sc
     }
 
+    /// The min dihedral an insertion around tet `t` aims at first:
+    /// [`LIFT_GOAL`] with `lift` for a tet under [`LIFT_DEG`], else none
+    /// (the count under [`SMALL_DIHEDRAL`]).
+    pub(crate) fn lift_goal(&self, t: u32, lift: bool) -> Option<f64> {
+        (lift && min_dihedral_deg(self.pts(self.m.tets[t as usize])) < LIFT_DEG)
+            .then_some(LIFT_GOAL)
+    }
+
     /// Evaluates inserting a point around bad tet `t`; on success `c`
     /// holds the replacement (the new point's id is `m.points.len()`) and
     /// the point's position is returned. `lift`: the min dihedral to aim

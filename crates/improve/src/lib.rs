@@ -409,9 +409,7 @@ impl<'m> Improver<'m> {
         if t as usize >= self.w.m.tets.len() || !self.w.alive(t) {
             return Outcome::NotFound;
         }
-        let lift = (lift
-            && quality::min_dihedral_deg(self.w.pts(self.w.m.tets[t as usize])) < insert::LIFT_DEG)
-            .then_some(insert::LIFT_GOAL);
+        let lift = self.w.lift_goal(t, lift);
         self.insert_with(t, lift)
     }
 

@@ -34,7 +34,7 @@ pub enum Outcome {
 }
 
 /// A replacement the operations evaluate before committing it.
-#[derive(Default)]
+#[derive(Clone, Default)]
 pub(crate) struct Cand {
     pub old: Vec<u32>,
     pub new: Vec<[PointId; 4]>,

@@ -169,18 +169,8 @@ impl Improver<'_> {
             .map_init(
                 || (insert::InsScratch::default(), Cand::default()),
                 |(s, c), &t| {
-                    let lift = (lift
-                        && quality::min_dihedral_deg(w.pts(w.m.tets[t as usize]))
-                            < insert::LIFT_DEG)
-                        .then_some(insert::LIFT_GOAL);
-                    w.eval_insert(t, lift, s, c).map(|pos| {
-                        let out = Cand {
-                            old: c.old.clone(),
-                            new: c.new.clone(),
-                            qmin: c.qmin,
-                        };
-                        (pos, out)
-                    })
+                    w.eval_insert(t, w.lift_goal(t, lift), s, c)
+                        .map(|pos| (pos, c.clone()))
                 },
             )
             .collect()

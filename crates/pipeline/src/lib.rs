@@ -690,7 +690,9 @@ fn fill_whole(
     seeds: &[parafront_geom::P3],
 ) -> Option<(Vec<parafront_geom::P3>, Vec<[u32; 4]>)> {
     let field = |p| sizing.size(p);
-    let (points, _) = region_points(s, sizing, rf);
+    // The front took the points; this path is rare, so they are gathered
+    // again rather than copied on every run.
+    let (mut points, _) = region_points(s, sizing, rf);
     let fill = parafront_delaunay::fill_cavity(
         &points,
         &rf.faces,
@@ -700,25 +702,14 @@ fn fill_whole(
         },
     )
     .ok()?;
-    let mut all = points;
-    all.extend_from_slice(&fill.steiner);
-    let tets = match parafront_delaunay::refine_to_size(
-        &all,
-        &fill.tets,
-        seeds,
-        &field,
-        &parafront_delaunay::RefineOptions::default(),
-    ) {
-        Ok(r) => {
-            all.extend_from_slice(&r.points);
-            r.tets
-        }
-        Err(err) => {
+    let opts = parafront_delaunay::RefineOptions::default();
+    let fill = parafront_delaunay::refine_fill(&points, &fill, seeds, &field, &opts)
+        .unwrap_or_else(|err| {
             tracing::warn!(region = rf.region_id, %err, "the region's fill was not refined");
-            fill.tets
-        }
-    };
-    Some((all, tets))
+            fill
+        });
+    points.extend_from_slice(&fill.steiner);
+    Some((points, fill.tets))
 }
 
 /// §2's optimal space-filling tets in region `rf` (its surface points

@@ -146,6 +146,7 @@ impl<'a> Front<'a> {
     /// every tet the front made gives way to it; `false` leaves the front
     /// as it was.
     pub(super) fn fill_early(&mut self) -> bool {
+        self.early = false;
         let faces = std::mem::take(&mut self.input0);
         let fopts = FillOptions {
             segments_first: true,
@@ -156,6 +157,8 @@ impl<'a> Front<'a> {
             "front stalled at once: constrained fill of the region"
         );
         let Some(fill) = self.whole_fill(&faces, &fopts) else {
+            // Kept for the fill and the refinement.
+            self.input0 = faces;
             return false;
         };
         let n = self.pts.len() as u32;
@@ -209,7 +212,7 @@ impl<'a> Front<'a> {
         let SizeMode::Field(size) = self.size else {
             return false;
         };
-        let faces = std::mem::take(&mut self.region0);
+        let faces = std::mem::take(&mut self.input0);
         if faces.is_empty() {
             return false;
         }
@@ -226,33 +229,19 @@ impl<'a> Front<'a> {
         let Some(fill) = self.whole_fill(&faces, &fopts) else {
             return false;
         };
-        let n = self.pts.len();
-        let mut all = self.pts.clone();
-        all.extend_from_slice(&fill.steiner);
-        let refined = match parafront_delaunay::refine_to_size(
-            &all,
-            &fill.tets,
-            &[],
-            size,
-            &parafront_delaunay::RefineOptions::default(),
-        ) {
-            Ok(r) => r,
+        let opts = parafront_delaunay::RefineOptions::default();
+        let fill = match parafront_delaunay::refine_fill(&self.pts, &fill, &[], size, &opts) {
+            Ok(f) => f,
             Err(e) => {
                 tracing::debug!(error = %e, "region fill not refined");
                 return false;
             }
         };
-        let mut steiner = fill.steiner;
-        steiner.extend_from_slice(&refined.points);
-        let fill = parafront_delaunay::Fill {
-            steiner,
-            tets: refined.tets,
-            ..fill
-        };
         // The region is one cavity now: the fills before it gave way.
         self.stats.cavities_filled = 0;
         self.stats.fill_tets = 0;
-        self.take_whole(&faces, fill, n as u32);
+        let n = self.pts.len() as u32;
+        self.take_whole(&faces, fill, n);
         self.stats.regions_refined += 1;
         true
     }

@@ -222,12 +222,13 @@ struct Front<'a> {
     /// where: the one committed keeps its place.
     new_at: Vec<(P3, u32)>,
     relax: u32,
-    /// The input front, kept while the first stall may still hand it
-    /// whole to the fill ([`EARLY_FILL_TETS`]).
+    /// The input front, kept until the first recovery round: the first
+    /// stall may hand it whole to the fill ([`Front::fill_early`], while
+    /// `early`), or to the fill and the refinement ([`REGION_FILL_SHARE`]).
     input0: Vec<[u32; 3]>,
-    /// The input front again, kept until the first stall, which may hand
-    /// it whole to the fill and the refinement ([`REGION_FILL_SHARE`]).
-    region0: Vec<[u32; 3]>,
+    /// The front has made too few tets for its input yet
+    /// ([`EARLY_FILL_TETS`]).
+    early: bool,
     /// Faces of the input front.
     n_input_faces: usize,
     opts: &'a FrontOptions,
@@ -371,7 +372,7 @@ impl<'a> Front<'a> {
             new_at: Vec::new(),
             relax: 0,
             input0: Vec::new(),
-            region0: Vec::new(),
+            early: false,
             n_input_faces: input.faces.len(),
             opts,
             region,
@@ -393,10 +394,8 @@ impl<'a> Front<'a> {
             f.add_face(v, NONE);
         }
         if opts.fill && opts.fill_early && !opts.pass && input.faces.len() >= EARLY_FILL_MIN_FACES {
-            if opts.fill_at_stall && matches!(size, SizeMode::Field(_)) {
-                f.region0.clone_from(&input.faces);
-            }
             f.input0 = input.faces;
+            f.early = true;
         }
         f
     }
@@ -491,10 +490,10 @@ impl<'a> Front<'a> {
                         if self.pts.len() > self.opts.max_points {
                             return Err(FrontError::TooManyPoints(self.opts.max_points));
                         }
-                        if !self.input0.is_empty()
+                        if self.early
                             && self.stats.tets as f64 > EARLY_FILL_TETS * self.input0.len() as f64
                         {
-                            self.input0 = Vec::new();
+                            self.early = false;
                         }
                     }
                     Outcome::Prohibited => self.prohibited.push(fid),
@@ -549,7 +548,7 @@ impl<'a> Front<'a> {
             // A front that stalls before it has made a tet for every other
             // input face (a surface of needles under a size that no tet on
             // them can meet) hands the whole region to the fill.
-            if self.relax == 0 && !self.input0.is_empty() && self.fill_early() {
+            if self.relax == 0 && self.early && self.fill_early() {
                 continue;
             }
             // A first stall on much of the surface (CAD parts, whose long
@@ -570,7 +569,7 @@ impl<'a> Front<'a> {
                 // region's own surface, filled and refined, costs less than
                 // their recovery.
                 if self.stuck.len() as f64 >= REGION_FILL_SHARE * self.n_input_faces as f64
-                    && !self.region0.is_empty()
+                    && !self.input0.is_empty()
                 {
                     if self.opts.hand_over {
                         return Err(FrontError::HandOver);
@@ -581,7 +580,6 @@ impl<'a> Front<'a> {
                 }
             }
             self.input0 = Vec::new();
-            self.region0 = Vec::new();
             self.recover();
             debug_assert_eq!(self.check(), Ok(()), "after recovery round {}", self.relax);
         }
@@ -623,7 +621,7 @@ impl<'a> Front<'a> {
     fn finish(self) -> FrontResult {
         // The search structures go first: the output is built in place, so
         // the peak is the front's own.
-        drop((self.heap, self.fmap, self.fgrid, self.input0, self.region0));
+        drop((self.heap, self.fmap, self.fgrid, self.input0));
         drop((self.near_f, self.near_p, self.cands, self.stamp, self.stuck));
         let front: Vec<[u32; 3]> = self
             .prohibited
