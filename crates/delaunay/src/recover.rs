@@ -83,13 +83,24 @@ pub(crate) fn recover_edge(
     depth: u32,
 ) -> bool {
     let present = |t: &Triangulation| t.has_edge(a, b);
-    let blockers = |t: &Triangulation| segment_crossings(t, a, b);
+    let mut memo = FxHashMap::default();
+    let blockers = |t: &Triangulation| segment_crossings(t, a, b, &mut memo);
     flip_until(tri, present, blockers, protect, budget, flips, depth)
 }
 
+/// Where segment `a`-`b` pierces a face (its points in order): the
+/// distance along it and the face's edge it passes through, if any.
+type SegHit = Option<(f64, Option<(u32, u32)>)>;
+
 /// The edges segment `a`-`b` passes through (their interiors) and the
-/// faces it pierces, in order from `a`.
-fn segment_crossings(tri: &Triangulation, a: u32, b: u32) -> (Vec<(u32, u32)>, Vec<u32>) {
+/// faces it pierces, in order from `a`. `memo` keeps each face's answer
+/// for the next call on the same segment (points do not move).
+fn segment_crossings(
+    tri: &Triangulation,
+    a: u32,
+    b: u32,
+    memo: &mut FxHashMap<[u32; 3], SegHit>,
+) -> (Vec<(u32, u32)>, Vec<u32>) {
     let (pa, pb) = (tri.pts[a as usize], tri.pts[b as usize]);
     let near = tets_near(tri, &[a], &[pa, pb], |tp| segment_near_tet(pa, pb, tp));
     // (distance along the segment, the face, the edge it passes through).
@@ -108,25 +119,31 @@ fn segment_crossings(tri: &Triangulation, a: u32, b: u32) -> (Vec<(u32, u32)>, V
             {
                 continue;
             }
-            let wp = w.map(|v| tri.pts[v as usize]);
-            let sides = (
-                orient3d(wp[0], wp[1], wp[2], pa),
-                orient3d(wp[0], wp[1], wp[2], pb),
-            );
-            if !pierces(pa, pb, wp, sides) {
+            let hit = *memo.entry(w).or_insert_with(|| {
+                let wp = w.map(|v| tri.pts[v as usize]);
+                let sides = (
+                    orient3d(wp[0], wp[1], wp[2], pa),
+                    orient3d(wp[0], wp[1], wp[2], pb),
+                );
+                if !pierces(pa, pb, wp, sides) {
+                    return None;
+                }
+                // The edge it passes through, if any.
+                let s = [
+                    orient3d(pa, pb, wp[0], wp[1]),
+                    orient3d(pa, pb, wp[1], wp[2]),
+                    orient3d(pa, pb, wp[2], wp[0]),
+                ];
+                let e = (0..3)
+                    .find(|&e| s[e] == 0.0)
+                    .map(|e| (w[e], w[(e + 1) % 3]));
+                let c = [0, 1, 2].map(|j| (wp[0][j] + wp[1][j] + wp[2][j]) / 3.0);
+                let along = (0..3).map(|j| (c[j] - pa[j]) * d[j]).sum::<f64>();
+                Some((along, e))
+            });
+            let Some((along, e)) = hit else {
                 continue;
-            }
-            // The edge it passes through, if any.
-            let s = [
-                orient3d(pa, pb, wp[0], wp[1]),
-                orient3d(pa, pb, wp[1], wp[2]),
-                orient3d(pa, pb, wp[2], wp[0]),
-            ];
-            let e = (0..3)
-                .find(|&e| s[e] == 0.0)
-                .map(|e| (w[e], w[(e + 1) % 3]));
-            let c = [0, 1, 2].map(|j| (wp[0][j] + wp[1][j] + wp[2][j]) / 3.0);
-            let along = (0..3).map(|j| (c[j] - pa[j]) * d[j]).sum::<f64>();
+            };
             hits.push((along, 4 * t + k as u32, e));
         }
     }
@@ -230,7 +247,8 @@ fn recover_face(
     depth: u32,
 ) -> bool {
     let present = |t: &Triangulation| t.find_face(f).is_some();
-    let blockers = |t: &Triangulation| crossings(t, f);
+    let mut memo = CrossMemo::default();
+    let blockers = |t: &Triangulation| crossings_memo(t, f, &mut memo);
     flip_until(tri, present, blockers, protect, budget, flips, depth)
 }
 
@@ -239,7 +257,7 @@ fn recover_face(
 fn flip_until(
     tri: &mut Triangulation,
     present: impl Fn(&Triangulation) -> bool,
-    blockers: impl Fn(&Triangulation) -> (Vec<(u32, u32)>, Vec<u32>),
+    mut blockers: impl FnMut(&Triangulation) -> (Vec<(u32, u32)>, Vec<u32>),
     protect: &FxHashSet<[u32; 3]>,
     budget: usize,
     flips: &mut usize,
@@ -336,10 +354,32 @@ fn flip_one(
     false
 }
 
+/// What [`crossings_memo`] learnt about one face: each point's side of its
+/// plane, and whether an edge or a face (by its points' ids) is in its
+/// way. Points never move while a face is recovered, so the answers hold
+/// across its flips; on a CAD plane most points are in the face's plane,
+/// the exact predicate's slowest answer.
+#[derive(Default)]
+pub(crate) struct CrossMemo {
+    side: FxHashMap<u32, f64>,
+    edge: FxHashMap<(u32, u32), bool>,
+    face: FxHashMap<[u32; 3], bool>,
+}
+
 /// The triangulation's edges that meet face `f` (outside its own edges),
 /// and its faces that an edge of `f` pierces, found among the tets near
 /// `f`.
 pub(crate) fn crossings(tri: &Triangulation, f: [u32; 3]) -> (Vec<(u32, u32)>, Vec<u32>) {
+    crossings_memo(tri, f, &mut CrossMemo::default())
+}
+
+/// [`crossings`], with what `memo` holds about `f` from earlier calls (and
+/// adding to it).
+pub(crate) fn crossings_memo(
+    tri: &Triangulation,
+    f: [u32; 3],
+    memo: &mut CrossMemo,
+) -> (Vec<(u32, u32)>, Vec<u32>) {
     let p = f.map(|v| tri.pts[v as usize]);
     // A point off the face's plane, to order points within it.
     let off = add(p[0], cross(sub(p[1], p[0]), sub(p[2], p[0])));
@@ -348,15 +388,7 @@ pub(crate) fn crossings(tri: &Triangulation, f: [u32; 3]) -> (Vec<(u32, u32)>, V
     let mut eseen: FxHashSet<(u32, u32)> = FxHashSet::default();
     let mut faces: Vec<u32> = Vec::new();
     let mut fseen: FxHashSet<[u32; 3]> = FxHashSet::default();
-    // Each point's side of the face's plane, once: on a CAD plane most are
-    // zero, the exact predicate's slowest answer, and every point ends
-    // several edges.
-    let mut side: FxHashMap<u32, f64> = FxHashMap::default();
-    let mut side_of = |v: u32| {
-        *side
-            .entry(v)
-            .or_insert_with(|| orient3d(p[0], p[1], p[2], tri.pts[v as usize]))
-    };
+    let CrossMemo { side, edge, face } = memo;
     for &t in &near {
         let tv = tri.tet(t);
         for a in 0..4 {
@@ -365,27 +397,40 @@ pub(crate) fn crossings(tri: &Triangulation, f: [u32; 3]) -> (Vec<(u32, u32)>, V
                 if f.contains(&u) && f.contains(&v) || !eseen.insert((u, v)) {
                     continue;
                 }
-                let sides = (side_of(u), side_of(v));
-                if edge_blocks(tri, p, f, off, (u, v), sides) {
+                let blocks = *edge.entry((u, v)).or_insert_with(|| {
+                    let mut side_of = |v: u32| {
+                        *side
+                            .entry(v)
+                            .or_insert_with(|| orient3d(p[0], p[1], p[2], tri.pts[v as usize]))
+                    };
+                    let sides = (side_of(u), side_of(v));
+                    edge_blocks(tri, p, f, off, (u, v), sides)
+                });
+                if blocks {
                     edges.push((u, v));
                 }
             }
         }
         for k in 0..4 {
             let w = TET_FACES[k].map(|j| tv[j]);
-            if tri.neighbour(t, k) == NONE || !fseen.insert(key3(w)) {
+            let key = key3(w);
+            if tri.neighbour(t, k) == NONE || !fseen.insert(key) {
                 continue;
             }
-            let wp = w.map(|v| tri.pts[v as usize]);
-            // The face's corners' sides of this plane, each once.
-            let mut o: [Option<f64>; 3] = [None; 3];
-            let mut o_of =
-                |k: usize| *o[k].get_or_insert_with(|| orient3d(wp[0], wp[1], wp[2], p[k]));
-            let pierced = (0..3).any(|e| {
-                let (a, b) = (f[e], f[(e + 1) % 3]);
-                !w.contains(&a)
-                    && !w.contains(&b)
-                    && pierces(p[e], p[(e + 1) % 3], wp, (o_of(e), o_of((e + 1) % 3)))
+            // Whether an edge of `f` pierces `w` does not depend on `w`'s
+            // orientation.
+            let pierced = *face.entry(key).or_insert_with(|| {
+                let wp = w.map(|v| tri.pts[v as usize]);
+                // The face's corners' sides of this plane, each once.
+                let mut o: [Option<f64>; 3] = [None; 3];
+                let mut o_of =
+                    |k: usize| *o[k].get_or_insert_with(|| orient3d(wp[0], wp[1], wp[2], p[k]));
+                (0..3).any(|e| {
+                    let (a, b) = (f[e], f[(e + 1) % 3]);
+                    !w.contains(&a)
+                        && !w.contains(&b)
+                        && pierces(p[e], p[(e + 1) % 3], wp, (o_of(e), o_of((e + 1) % 3)))
+                })
             });
             if pierced {
                 faces.push(4 * t + k as u32);
