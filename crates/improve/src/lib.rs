@@ -307,6 +307,7 @@ pub struct Improver<'m> {
     c: Cand,
     best: Cand,
     batch: batch::Batch,
+    points: batch::PointBatch,
 }
 
 impl<'m> Improver<'m> {
@@ -322,6 +323,7 @@ impl<'m> Improver<'m> {
             c: Cand::default(),
             best: Cand::default(),
             batch: Default::default(),
+            points: Default::default(),
         })
     }
 

@@ -532,21 +532,23 @@ impl Work<'_> {
         }
     }
 
-    /// §9.4 selective movement: try `p` along each of its edges, both ways,
-    /// at a few fractions of the edge length; keep the best move if it
-    /// raises the worst quality of the ball and the ball's mean quality
-    /// drops by at most [`SELECTIVE_TRADE`] times that gain.
-    pub(crate) fn selective_move(&mut self, p: PointId, s: &mut Scratch) -> Outcome {
-        self.on_ball(p, s, |w, ball, s| w.selective_move_in(p, ball, s))
-    }
-
-    fn selective_move_in(&mut self, p: PointId, ball: &[u32], s: &mut Scratch) -> Outcome {
-        self.neighbours(p, ball, &mut s.nb);
+    /// §9.4 selective movement: where to move `p` (its ball `ball`) along
+    /// each of its edges, both ways, at a few fractions of the edge
+    /// length: the best move if it raises the worst quality of the ball
+    /// and the ball's mean quality drops by at most [`SELECTIVE_TRADE`]
+    /// times that gain. `nb` is scratch.
+    pub(crate) fn eval_selective(
+        &self,
+        p: PointId,
+        ball: &[u32],
+        nb: &mut Vec<PointId>,
+    ) -> Option<P3> {
+        self.neighbours(p, ball, nb);
         let qmin = self.ball_qmin(ball);
         let p0 = self.m.points[p.idx()];
         let mean0 = ball.iter().map(|&t| self.q[t as usize]).sum::<f64>() / ball.len() as f64;
         let mut best: Option<(f64, P3)> = None;
-        for &x in &s.nb {
+        for &x in nb.iter() {
             let d = parafront_geom::sub(self.m.points[x.idx()], p0);
             for f in [0.25, 0.1, 0.03, -0.03, -0.1, -0.25] {
                 let pos = [0, 1, 2].map(|k| p0[k] + f * d[k]);
@@ -558,8 +560,13 @@ impl Work<'_> {
                 }
             }
         }
-        match best {
-            Some((_, pos)) => {
+        best.map(|b| b.1)
+    }
+
+    /// Moves `p` (its ball `ball`) to `pos` if a search found it.
+    pub(crate) fn commit_found(&mut self, p: PointId, pos: Option<P3>, ball: &[u32]) -> Outcome {
+        match pos {
+            Some(pos) => {
                 self.commit_move(p, pos, ball);
                 Outcome::Done
             }
@@ -568,25 +575,21 @@ impl Work<'_> {
     }
 
     /// The last polish for the min dihedral (§9.4's selective movement,
-    /// by a compass search): moves free point `p` to raise the smallest
-    /// dihedral angle of its ball, while no tet inverts and the ball's
-    /// worst mean ratio stays above `keep` times what it was and no more
-    /// of its tets are under 10°. Caps (a
-    /// surface triangle with an angle near 180° and a free apex) sit where
-    /// the mean ratio is best but their dihedral is not: on skull.obj a
-    /// tenth of the worst mean ratio buys 0.14° -> 0.22°.
-    pub(crate) fn dihedral_move(&mut self, p: PointId, keep: f64, s: &mut Scratch) -> Outcome {
-        self.on_ball(p, s, |w, ball, s| w.dihedral_move_in(p, keep, ball, s))
-    }
-
-    fn dihedral_move_in(
-        &mut self,
+    /// by a compass search): where to move free point `p` (its ball
+    /// `ball`) to raise the smallest dihedral angle of its ball, while no
+    /// tet inverts and the ball's worst mean ratio stays above `keep` times
+    /// what it was and no more of its tets are under 10°. Caps (a surface
+    /// triangle with an angle near 180° and a free apex) sit where the
+    /// mean ratio is best but their dihedral is not: on skull.obj a tenth
+    /// of the worst mean ratio buys 0.14° -> 0.22°. `nb` is scratch.
+    pub(crate) fn eval_dihedral(
+        &self,
         p: PointId,
         keep: f64,
         ball: &[u32],
-        s: &mut Scratch,
-    ) -> Outcome {
-        self.neighbours(p, ball, &mut s.nb);
+        nb: &mut Vec<PointId>,
+    ) -> Option<P3> {
+        self.neighbours(p, ball, nb);
         let floor = keep * self.ball_qmin(ball);
         // (min dihedral, tets under 10°) of the ball with p at pos, when no
         // tet inverts or falls under the mean ratio floor.
@@ -605,14 +608,12 @@ impl Work<'_> {
             Some((d, under))
         };
         let p0 = self.m.points[p.idx()];
-        let len =
-            s.nb.iter()
-                .map(|x| dist2(self.m.points[x.idx()], p0).sqrt())
-                .sum::<f64>()
-                / s.nb.len().max(1) as f64;
-        let Some((d0, under0)) = eval(self, p0) else {
-            return Outcome::NotBetter;
-        };
+        let len = nb
+            .iter()
+            .map(|x| dist2(self.m.points[x.idx()], p0).sqrt())
+            .sum::<f64>()
+            / nb.len().max(1) as f64;
+        let (d0, under0) = eval(self, p0)?;
         // No more tets under 10° than before: the share under 10° is the
         // issue's other criterion.
         let (best, pos) = compass(
@@ -624,23 +625,20 @@ impl Work<'_> {
             |c, _| eval(self, c).filter(|e| e.1 <= under0).map(|e| e.0),
             |d, cur| *d > *cur + 1e-9,
         );
-        if best > d0 * (1.0 + MARGIN) + 1e-9 {
-            self.commit_move(p, pos, ball);
-            Outcome::Done
-        } else {
-            Outcome::NotBetter
-        }
+        (best > d0 * (1.0 + MARGIN) + 1e-9).then_some(pos)
     }
 
-    /// Moves free point `p` by a compass search to leave fewer tets of its
-    /// ball under 10°, with a min dihedral no lower (the issue's
-    /// measure is the point here, not the mean ratio; see `insert.rs`).
-    pub(crate) fn count_move(&mut self, p: PointId, s: &mut Scratch) -> Outcome {
-        self.on_ball(p, s, |w, ball, s| w.count_move_in(p, ball, s))
-    }
-
-    fn count_move_in(&mut self, p: PointId, ball: &[u32], s: &mut Scratch) -> Outcome {
-        self.neighbours(p, ball, &mut s.nb);
+    /// Where to move free point `p` (its ball `ball`) by a compass search
+    /// to leave fewer tets of its ball under 10°, with a min dihedral no
+    /// lower (the measure is the point here, not the mean ratio;
+    /// see `insert.rs`). `nb` is scratch.
+    pub(crate) fn eval_count_move(
+        &self,
+        p: PointId,
+        ball: &[u32],
+        nb: &mut Vec<PointId>,
+    ) -> Option<P3> {
+        self.neighbours(p, ball, nb);
         // (tets under 10°, shortfall below 12°, min dihedral) with p at pos;
         // None when a tet inverts, more than `cap` are under 10° or one is
         // under `floor` (the search's bounds, checked as it goes).
@@ -675,13 +673,11 @@ impl Work<'_> {
             a.0 < b.0 || (a.0 == b.0 && a.1 < b.1 - 1e-9)
         };
         let p0 = self.m.points[p.idx()];
-        let len =
-            s.nb.iter()
-                .map(|x| dist2(self.m.points[x.idx()], p0).sqrt())
-                .fold(f64::INFINITY, f64::min);
-        let Some(e0) = eval(self, p0, usize::MAX, f64::NEG_INFINITY, false) else {
-            return Outcome::NotBetter;
-        };
+        let len = nb
+            .iter()
+            .map(|x| dist2(self.m.points[x.idx()], p0).sqrt())
+            .fold(f64::INFINITY, f64::min);
+        let e0 = eval(self, p0, usize::MAX, f64::NEG_INFINITY, false)?;
         let (best, pos) = compass(
             p0,
             e0,
@@ -691,11 +687,6 @@ impl Work<'_> {
             |c, cur| eval(self, c, cur.0, e0.2, true),
             |a, b| better(*a, *b),
         );
-        if best.0 < e0.0 {
-            self.commit_move(p, pos, ball);
-            Outcome::Done
-        } else {
-            Outcome::NotBetter
-        }
+        (best.0 < e0.0).then_some(pos)
     }
 }

@@ -232,29 +232,35 @@ impl Improver<'_> {
     }
 
     /// Moves the free points of the tets under 10° to leave fewer of them
-    /// ([`Work::count_move`]), worst tet first. Counted with the
+    /// ([`Work::eval_count_move`]), worst tet first. Counted with the
     /// selective movement.
     pub(crate) fn count_pass(&mut self, st: &mut ImproveStats) {
         let t0 = Instant::now();
         let bad = self.under_deg(insert::SMALL_DIHEDRAL);
         let mut seen = vec![false; self.w.m.points.len()];
+        let mut list = Vec::new();
         for (_, t) in bad {
             for p in self.w.m.tets[t as usize] {
-                if self.w.frozen[p.idx()] || seen[p.idx()] {
-                    continue;
-                }
-                seen[p.idx()] = true;
-                if self.w.move_idle(p) {
-                    continue;
-                }
-                st.selective.tried += 1;
-                if self.w.count_move(p, &mut self.s) == Outcome::Done {
-                    st.selective.done += 1;
-                } else {
-                    self.w.move_idle[p.idx()] = self.w.tick();
+                if !self.w.frozen[p.idx()] && !seen[p.idx()] {
+                    seen[p.idx()] = true;
+                    list.push(p);
                 }
             }
         }
+        // The compass searches are most of this pass's time: in batches.
+        self.move_in_batches(
+            list,
+            |s, p| !s.w.move_idle(p),
+            |w, p, ball, nb| w.eval_count_move(p, ball, nb),
+            |s, p, o| {
+                st.selective.tried += 1;
+                if o == Outcome::Done {
+                    st.selective.done += 1;
+                } else {
+                    s.w.move_idle[p.idx()] = s.w.tick();
+                }
+            },
+        );
         st.selective.seconds += t0.elapsed().as_secs_f64();
     }
 
@@ -398,7 +404,7 @@ impl Improver<'_> {
 
     /// The last polish: the free points of the tets under
     /// [`DIHEDRAL_POLISH`] degrees, worst tet first, move to raise their
-    /// ball's min dihedral ([`Work::dihedral_move`]). Counted with the
+    /// ball's min dihedral ([`Work::eval_dihedral`]). Counted with the
     /// selective movement.
     pub(crate) fn dihedral_pass(&mut self, st: &mut ImproveStats) {
         let t0 = Instant::now();
@@ -414,19 +420,23 @@ impl Improver<'_> {
             .filter(|&(d, _)| d < DIHEDRAL_POLISH)
             .collect();
         worst.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-        let mut seen = vec![];
+        let mut list = vec![];
         for (_, t) in worst {
             for p in self.w.m.tets[t as usize] {
-                if self.w.frozen[p.idx()] || seen.contains(&p) {
-                    continue;
-                }
-                seen.push(p);
-                st.selective.tried += 1;
-                if self.w.dihedral_move(p, DIHEDRAL_KEEP, &mut self.s) == Outcome::Done {
-                    st.selective.done += 1;
+                if !self.w.frozen[p.idx()] && !list.contains(&p) {
+                    list.push(p);
                 }
             }
         }
+        self.move_in_batches(
+            list,
+            |_, _| true,
+            |w, p, ball, nb| w.eval_dihedral(p, DIHEDRAL_KEEP, ball, nb),
+            |_, _, o| {
+                st.selective.tried += 1;
+                st.selective.done += usize::from(o == Outcome::Done);
+            },
+        );
         st.selective.seconds += t0.elapsed().as_secs_f64();
     }
 
@@ -441,12 +451,15 @@ impl Improver<'_> {
             .collect();
         pts.sort_unstable();
         pts.dedup();
-        for p in pts {
-            st.selective.tried += 1;
-            if self.w.selective_move(p, &mut self.s) == Outcome::Done {
-                st.selective.done += 1;
-            }
-        }
+        self.move_in_batches(
+            pts,
+            |_, _| true,
+            |w, p, ball, nb| w.eval_selective(p, ball, nb),
+            |_, _, o| {
+                st.selective.tried += 1;
+                st.selective.done += usize::from(o == Outcome::Done);
+            },
+        );
         st.selective.seconds += t0.elapsed().as_secs_f64();
     }
 }

@@ -224,12 +224,13 @@ fn smooth_bodies_in_parts_reach_twenty_degrees() {
     }
 }
 
-/// The point insertion evaluates its tets in batches, at once, and
-/// commits them in order: on a CAD part (the hinge, whose needle
-/// triangles leave hundreds of tets under 10°) the improved mesh is the
-/// same on 1 and on 3 threads, valid, with points inserted.
+/// The point insertion and the point moves (selective, dihedral and
+/// count searches) evaluate in batches, at once, and commit in order: on
+/// a CAD part (the hinge, whose needle triangles leave hundreds of tets
+/// under 10°) the improved mesh is the same on 1 and on 3 threads, valid,
+/// with points inserted and moved.
 #[test]
-fn batched_insertion_is_independent_of_threads() {
+fn batched_insertion_and_moves_are_independent_of_threads() {
     use parafront_surface::read::{read_surface_bytes, Format};
     let text = include_str!("../../delaunay/tests/data/hinge_surface.obj");
     // Its faces point inward, as the delaunay crate's fills take them.
@@ -249,7 +250,9 @@ fn batched_insertion_is_independent_of_threads() {
     let (m1, st1) = run(1);
     let (m3, st3) = run(3);
     assert!(st1.points_inserted > 10, "{st1:?}");
+    assert!(st1.selective.done > 10, "{st1:?}");
     assert_eq!(st1.points_inserted, st3.points_inserted);
+    assert_eq!(st1.selective.done, st3.selective.done);
     assert_eq!(m1.tets, m3.tets);
     assert_eq!(m1.points, m3.points);
     m1.check_against_surface(&s.tris).unwrap();
