@@ -174,6 +174,7 @@ impl Improver<'_> {
             let w = &self.w;
             let found: Vec<Option<P3>> = (0..b.pts.len())
                 .into_par_iter()
+                .with_max_len(1)
                 .map_init(Vec::new, |nb, i| eval(w, b.pts[i], b.ball(i), nb))
                 .collect();
             for (i, pos) in found.into_iter().enumerate() {

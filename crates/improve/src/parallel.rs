@@ -159,8 +159,10 @@ fn pass(
     }
     let kept: Vec<[PointId; 4]> = keep.iter().map(|&t| mesh.tets[t as usize]).collect();
     let kept_region: Vec<u32> = keep.iter().map(|&t| mesh.region[t as usize]).collect();
+    // One part per task (as the fills' cavities): parts differ in cost.
     let pieces: Vec<Piece> = groups
         .par_iter()
+        .with_max_len(1)
         .map(|g| cut(mesh, g, frozen, level))
         .collect::<Result<_, _>>()?;
     mesh.tets.clear();

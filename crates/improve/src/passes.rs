@@ -165,7 +165,10 @@ impl Improver<'_> {
     /// once; `lift` as [`Improver::insert_point`] takes it.
     fn eval_inserts(&self, tets: &[u32], lift: bool) -> Vec<Result<(P3, Cand), Outcome>> {
         let w = &self.w;
+        // One tet per task: their searches' costs differ tenfold, and
+        // rayon's halves would leave a thread waiting on the slower half.
         tets.par_iter()
+            .with_max_len(1)
             .map_init(
                 || (insert::InsScratch::default(), Cand::default()),
                 |(s, c), &t| {
