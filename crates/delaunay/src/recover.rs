@@ -550,4 +550,53 @@ mod tests {
             assert!(missing[1] < missing[0], "{missing:?}");
         }
     }
+
+    /// Recovery remembers, per face and per segment, which edges and faces
+    /// are in the way (points do not move while it flips): at every flip
+    /// of the thin cracks' faces and of their edges, what it remembered
+    /// gives the same answer as asking afresh.
+    #[test]
+    fn remembered_crossings_match_fresh_ones_as_flips_go_on() {
+        for text in [
+            include_str!("../tests/data/tray_crack_150.obj"),
+            include_str!("../tests/data/hinge_crack_184.obj"),
+        ] {
+            let (pts, cf) = read_obj(text);
+            let mut tri = Triangulation::new(&pts).unwrap();
+            let protect = FxHashSet::default();
+            let (mut faces_seen, mut segments_seen) = (0, 0);
+            for &f in &cf {
+                let mut memo = CrossMemo::default();
+                for _ in 0..8 {
+                    if tri.find_face(f).is_some() {
+                        break;
+                    }
+                    let fresh = crossings(&tri, f);
+                    assert_eq!(crossings_memo(&tri, f, &mut memo), fresh);
+                    faces_seen += 1;
+                    if !flip_one(&mut tri, &fresh.0, &fresh.1, &protect, DEPTH) {
+                        break;
+                    }
+                }
+                let (a, b) = (f[0], f[1]);
+                let mut memo = FxHashMap::default();
+                for _ in 0..8 {
+                    if tri.has_edge(a, b) {
+                        break;
+                    }
+                    let fresh = segment_crossings(&tri, a, b, &mut FxHashMap::default());
+                    assert_eq!(segment_crossings(&tri, a, b, &mut memo), fresh);
+                    segments_seen += 1;
+                    if !flip_one(&mut tri, &fresh.0, &fresh.1, &protect, DEPTH) {
+                        break;
+                    }
+                }
+            }
+            tri.check().unwrap();
+            assert!(
+                faces_seen > 100 && segments_seen > 10,
+                "{faces_seen} {segments_seen}"
+            );
+        }
+    }
 }
