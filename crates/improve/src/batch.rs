@@ -7,7 +7,7 @@
 //! next), is evaluated in parallel, and is committed in its order. The
 //! batches depend on the list and the mesh only, so the mesh is the same
 //! on any number of threads.
-use crate::work::Work;
+use crate::work::{Marks, Work};
 use crate::{Improver, Outcome};
 use parafront_geom::P3;
 use parafront_mesh::PointId;
@@ -23,9 +23,8 @@ const WINDOW: usize = 2 * BATCH;
 /// The points a batch holds, and the scratch to find a tet's.
 #[derive(Default)]
 pub(crate) struct Batch {
-    /// Per point, the batch that holds it (`epoch`) or an older one.
-    taken: Vec<u32>,
-    epoch: u32,
+    /// The points the batch holds.
+    taken: Marks,
     ball: Vec<u32>,
     pts: Vec<PointId>,
     rest: Vec<(f64, u32)>,
@@ -34,12 +33,9 @@ pub(crate) struct Batch {
 }
 
 impl Batch {
-    pub(crate) fn clear(&mut self) {
-        self.epoch = self.epoch.wrapping_add(1);
-        if self.epoch == 0 {
-            self.taken.iter_mut().for_each(|e| *e = 0);
-            self.epoch = 1;
-        }
+    /// Empty, for a mesh of `n` points.
+    fn clear(&mut self, n: usize) {
+        self.taken.clear(n);
         self.tets.clear();
     }
 
@@ -53,16 +49,13 @@ impl Batch {
                 self.pts.extend_from_slice(&w.m.tets[u as usize]);
             }
         }
-        if self.taken.len() < w.m.points.len() {
-            self.taken.resize(w.m.points.len(), 0);
-        }
-        !self.pts.iter().any(|p| self.taken[p.idx()] == self.epoch)
+        !self.pts.iter().any(|p| self.taken.contains(p.idx()))
     }
 
     /// `t` (checked [`Batch::apart`] just before) joins the batch.
     pub(crate) fn take(&mut self, t: u32) {
         for p in &self.pts {
-            self.taken[p.idx()] = self.epoch;
+            self.taken.insert(p.idx());
         }
         self.tets.push(t);
     }
@@ -81,7 +74,7 @@ impl Improver<'_> {
         pending: &mut Vec<(f64, u32)>,
         keep: impl Fn(&Self, f64, u32) -> bool,
     ) {
-        b.clear();
+        b.clear(self.w.m.points.len());
         let mut rest = std::mem::take(&mut b.rest);
         rest.clear();
         for (k, &(x0, t)) in pending.iter().enumerate() {
@@ -123,9 +116,8 @@ const POINT_BATCH: usize = 4;
 /// of another's ball, and keeps each one's ball for the evaluation.
 #[derive(Default)]
 pub(crate) struct PointBatch {
-    /// Per point, the batch that holds it (`epoch`) or an older one.
-    taken: Vec<u32>,
-    epoch: u32,
+    /// The points the batch holds.
+    taken: Marks,
     ball: Vec<u32>,
     rest: Vec<PointId>,
     /// The points of the batch, in list order.
@@ -136,12 +128,9 @@ pub(crate) struct PointBatch {
 }
 
 impl PointBatch {
-    fn clear(&mut self) {
-        self.epoch = self.epoch.wrapping_add(1);
-        if self.epoch == 0 {
-            self.taken.iter_mut().for_each(|e| *e = 0);
-            self.epoch = 1;
-        }
+    /// Empty, for a mesh of `n` points.
+    fn clear(&mut self, n: usize) {
+        self.taken.clear(n);
         self.pts.clear();
         self.tets.clear();
         self.start.clear();
@@ -195,10 +184,7 @@ impl Improver<'_> {
         pending: &mut Vec<PointId>,
         keep: impl Fn(&Self, PointId) -> bool,
     ) {
-        b.clear();
-        if b.taken.len() < self.w.m.points.len() {
-            b.taken.resize(self.w.m.points.len(), 0);
-        }
+        b.clear(self.w.m.points.len());
         let mut rest = std::mem::take(&mut b.rest);
         rest.clear();
         for (k, &p) in pending.iter().enumerate() {
@@ -210,14 +196,14 @@ impl Improver<'_> {
             let meets = b.ball.iter().any(|&t| {
                 self.w.m.tets[t as usize]
                     .iter()
-                    .any(|x| b.taken[x.idx()] == b.epoch)
+                    .any(|x| b.taken.contains(x.idx()))
             });
             if meets {
                 rest.push(p);
                 continue;
             }
             if keep(self, p) {
-                b.taken[p.idx()] = b.epoch;
+                b.taken.insert(p.idx());
                 b.pts.push(p);
                 b.tets.extend_from_slice(&b.ball);
                 b.start.push(b.tets.len());

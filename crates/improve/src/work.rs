@@ -65,13 +65,50 @@ pub(crate) struct Work<'m> {
     pub move_idle: Vec<u32>,
     pub clock: u32,
     free: Vec<u32>,
-    stamp: Vec<u32>,
-    gen: u32,
+    /// The tets [`Work::ball`] has reached.
+    reached: Marks,
     outer: Vec<([u32; 3], FaceRef)>,
     link: Vec<u32>,
     slots: Vec<u32>,
     used: Vec<bool>,
     cav: Vec<PointId>,
+}
+
+/// A set of indices that empties in O(1): an index is in it while its
+/// stamp is the current epoch (the tets a ball walk has reached, the
+/// points a batch holds).
+#[derive(Default)]
+pub(crate) struct Marks {
+    stamp: Vec<u32>,
+    epoch: u32,
+}
+
+impl Marks {
+    /// Empties the set, for indices below `n` from now on.
+    #[inline]
+    pub(crate) fn clear(&mut self, n: usize) {
+        self.epoch = self.epoch.wrapping_add(1);
+        if self.epoch == 0 {
+            self.stamp.iter_mut().for_each(|s| *s = 0);
+            self.epoch = 1;
+        }
+        if self.stamp.len() < n {
+            self.stamp.resize(n, 0);
+        }
+    }
+
+    /// Adds `i`; whether it was not in the set yet.
+    #[inline]
+    pub(crate) fn insert(&mut self, i: usize) -> bool {
+        let new = self.stamp[i] != self.epoch;
+        self.stamp[i] = self.epoch;
+        new
+    }
+
+    #[inline]
+    pub(crate) fn contains(&self, i: usize) -> bool {
+        self.stamp[i] == self.epoch
+    }
 }
 
 #[inline]
@@ -155,8 +192,7 @@ impl<'m> Work<'m> {
             clock: 1,
             q,
             free: Vec::new(),
-            stamp: vec![0; nt],
-            gen: 0,
+            reached: Marks::default(),
             outer: Vec::new(),
             link: Vec::new(),
             slots: Vec::new(),
@@ -229,15 +265,8 @@ impl<'m> Work<'m> {
             debug_assert!(t0 == u32::MAX, "p2t of {p} is stale");
             return;
         }
-        self.gen = self.gen.wrapping_add(1);
-        if self.gen == 0 {
-            self.stamp.iter_mut().for_each(|s| *s = 0);
-            self.gen = 1;
-        }
-        if self.stamp.len() < self.m.tets.len() {
-            self.stamp.resize(self.m.tets.len(), 0);
-        }
-        self.stamp[t0 as usize] = self.gen;
+        self.reached.clear(self.m.tets.len());
+        self.reached.insert(t0 as usize);
         out.push(t0);
         let mut i = 0;
         while i < out.len() {
@@ -252,8 +281,7 @@ impl<'m> Work<'m> {
                     continue;
                 }
                 let nt = n.tet().idx();
-                if self.stamp[nt] != self.gen {
-                    self.stamp[nt] = self.gen;
+                if self.reached.insert(nt) {
                     out.push(nt as u32);
                 }
             }
