@@ -31,6 +31,9 @@ struct Headway {
     fewest: usize,
     worse: u32,
     limit: u32,
+    /// A round that leaves more than this many times the fewest ends it
+    /// at once (0: never).
+    blowup: usize,
 }
 
 impl Headway {
@@ -39,6 +42,7 @@ impl Headway {
             fewest: usize::MAX,
             worse: 0,
             limit,
+            blowup: 0,
         }
     }
 
@@ -48,10 +52,20 @@ impl Headway {
             self.fewest = missing;
         } else if missing > self.fewest {
             self.worse += 1;
+            if self.blowup > 0 && missing > self.blowup * self.fewest {
+                return false;
+            }
         }
         self.limit == 0 || self.worse < self.limit
     }
 }
+
+/// [`Headway::blowup`] of the face rounds: each recovers every piece,
+/// dearer with each round of splits, so a round that leaves more than
+/// twice the fewest ends the fill (the plate at size 4: a 5,088-face
+/// cavity's pieces went 169, 436 and 1,017 missing in 2.4, 8.6 and 30 s
+/// before the limit ended it; at size 16 a 1,636-face one went 7, 8, 0).
+const FACE_BLOWUP: usize = 2;
 
 /// The cavity's points (`lp`, each face's corners index it) and faces; a
 /// fill as Steiner points and tets over `lp` then the Steiner points, or
@@ -69,7 +83,10 @@ pub(crate) fn conform_kept(
     let mut tri = Triangulation::new(lp).ok()?;
     let mut flips = 0;
     let mut edge_headway = Headway::new(headway_rounds);
-    let mut face_headway = Headway::new(headway_rounds);
+    let mut face_headway = Headway {
+        blowup: FACE_BLOWUP,
+        ..Headway::new(headway_rounds)
+    };
     for _ in 0..ROUNDS {
         // What is there to keep: the edges' pieces and the faces' pieces
         // the triangulation has.
@@ -237,5 +254,26 @@ mod tests {
         // Worse rounds need not follow each other.
         assert_eq!(run(3, &[50, 60, 40, 45, 30, 31]), Some(5));
         assert_eq!(run(0, &[80, 53, 59, 72, 77, 90, 100]), None);
+    }
+
+    /// With a blow-up factor, a round that leaves more than that many
+    /// times the fewest ends it at once; a slightly worse round does not.
+    #[test]
+    fn a_face_round_that_doubles_the_fewest_ends_the_fill() {
+        let run = |missing: &[usize]| {
+            let mut h = Headway {
+                blowup: super::FACE_BLOWUP,
+                ..Headway::new(3)
+            };
+            missing.iter().position(|&m| !h.goes_on(m))
+        };
+        // The plate at size 4's 5,088-face cavity: 436 > 2 x 169.
+        assert_eq!(run(&[169, 436, 1017]), Some(1));
+        // At size 16, a 1,636-face cavity that closes.
+        assert_eq!(run(&[7, 8, 0]), None);
+        // Exactly twice is not more than twice.
+        assert_eq!(run(&[10, 20, 5]), None);
+        // The count of worse rounds still ends it.
+        assert_eq!(run(&[10, 12, 14, 16]), Some(3));
     }
 }
