@@ -126,7 +126,12 @@ fn hinge_at_a_twentieth_of_its_size() {
     o.size.h = Some(2.5);
     let (m, summary) = mesh_surface(&s, &o).expect("the hinge at size 2.5 meshes");
     m.check_against_surface(&s.tris).expect("valid");
-    assert_eq!(summary.regions_filled, vec![1]);
+    // At the front's first stall, with no recovery round before it (the
+    // fill has a tet flat in floating point; refused, it cost 7 s of
+    // recovery that never closed, then the pipeline made the same fill).
+    assert_eq!(summary.regions_refined, vec![1]);
+    assert!(summary.regions_filled.is_empty());
+    assert_eq!(summary.recovery_rounds, 0);
     // Refined to the size: several times the surface's points.
     assert!(
         m.points.len() > 2 * s.points.len(),

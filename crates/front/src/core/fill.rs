@@ -156,7 +156,7 @@ impl<'a> Front<'a> {
             faces = faces.len(),
             "front stalled at once: constrained fill of the region"
         );
-        let Some(fill) = self.whole_fill(&faces, &fopts) else {
+        let Some(fill) = self.whole_fill(&faces, &fopts, false) else {
             // Kept for the fill and the refinement.
             self.input0 = faces;
             return false;
@@ -166,20 +166,21 @@ impl<'a> Front<'a> {
         true
     }
 
-    /// The fill of the whole input `faces`, unless it fails or has a tet
-    /// flat in floating point: exactly positive is valid, but such a tet (a
-    /// split point moved a hair off the surface, four corners on one CAD
-    /// plane) would be the improvement's to undo, and the front's tets
-    /// serve better.
+    /// The fill of the whole input `faces`, unless it fails or, without
+    /// `flat_ok`, has a tet flat in floating point: exactly positive is
+    /// valid, but such a tet (a split point moved a hair off the surface,
+    /// four corners on one CAD plane) would be the improvement's to undo,
+    /// and where the front can still close, its tets serve better.
     fn whole_fill(
         &self,
         faces: &[[u32; 3]],
         fopts: &FillOptions,
+        flat_ok: bool,
     ) -> Option<parafront_delaunay::Fill> {
         let fill = fill_cavity(&self.pts, faces, fopts)
             .map_err(|e| tracing::debug!(error = %e, "region not filled"))
             .ok()?;
-        if any_flat(&self.pts, &fill.steiner, &fill.tets) {
+        if !flat_ok && any_flat(&self.pts, &fill.steiner, &fill.tets) {
             tracing::debug!("region fill has a tet flat in floating point");
             return None;
         }
@@ -202,12 +203,19 @@ impl<'a> Front<'a> {
         self.prohibited.clear();
     }
 
-    /// The region's whole input surface filled (its edges split first, the
-    /// splits bounded as a cavity's) and refined to the size field by
-    /// Delaunay insertion: GDT (§2) in place of the front, for a region
-    /// whose first stall left cavities the fill could not close on much of
-    /// it. On success every tet the front made gives way to it; `false`
-    /// leaves the front as it was.
+    /// The region's whole input surface filled (its edges split first)
+    /// and refined to the size field by Delaunay insertion: GDT (§2) in
+    /// place of the front, for a region whose first stall left cavities the
+    /// fill could not close on much of it. On success every tet the front
+    /// made gives way to it; `false` leaves the front as it was.
+    ///
+    /// It is the fill the pipeline falls back on when the front gives up
+    /// (`FillOptions::segments_first`, the kernel's split budget), and like
+    /// that one it takes a fill with a tet flat in floating point. Where it
+    /// refused such a fill, or stopped at a cavity's split budget, the
+    /// front went on to recovery rounds that never closed these regions,
+    /// and the pipeline then made the same fill: the hinge at size 2 spent
+    /// 10 s so, round.stl at size 0.5 26 s, the plate at size 6 8 s.
     pub(super) fn fill_region(&mut self) -> bool {
         let SizeMode::Field(size) = self.size else {
             return false;
@@ -222,11 +230,9 @@ impl<'a> Front<'a> {
         );
         let fopts = FillOptions {
             segments_first: true,
-            max_split: ((faces.len() as f64 * SPLITS_PER_FACE) as usize).max(MIN_SPLITS),
-            headway_rounds: HEADWAY_ROUNDS,
             ..FillOptions::default()
         };
-        let Some(fill) = self.whole_fill(&faces, &fopts) else {
+        let Some(fill) = self.whole_fill(&faces, &fopts, true) else {
             return false;
         };
         let opts = parafront_delaunay::RefineOptions::default();
