@@ -1,6 +1,7 @@
 //! The tet store and Bowyer-Watson insertion.
 use crate::predicates::in_sphere_sos;
 use parafront_geom::{orient3d, Aabb, P3};
+use parafront_mesh::Marks;
 use rustc_hash::FxHashMap;
 
 /// No tet: the outside of the bounding tet, or a dead slot.
@@ -49,9 +50,9 @@ pub struct Triangulation {
     conflict: Vec<u32>,
     pub(crate) mark: Vec<u32>,
     epoch: u32,
-    /// Scratch for [`Triangulation::star`]: a mark per tet slot, its
-    /// epoch, and the walk's queue.
-    star_mark: std::cell::RefCell<(Vec<u32>, u32, Vec<u32>)>,
+    /// Scratch for [`Triangulation::star`]: the tet slots reached, and
+    /// the walk's queue.
+    star_mark: std::cell::RefCell<(Marks, Vec<u32>)>,
     /// Bumped by every change of the tets, for the memo below.
     pub(crate) generation: u64,
     /// The last [`Triangulation::edge_ring`] asked: its edge, the
@@ -452,15 +453,9 @@ impl Triangulation {
                 .find(|&t| self.tets[t as usize].contains(&v))?;
         }
         let mut scratch = self.star_mark.borrow_mut();
-        let (marks, epoch, queue) = &mut *scratch;
-        *epoch = epoch.wrapping_add(1);
-        if *epoch == 0 {
-            marks.iter_mut().for_each(|m| *m = 0);
-            *epoch = 1;
-        }
-        let ep = *epoch;
-        marks.resize(self.tets.len(), 0);
-        marks[t0 as usize] = ep;
+        let (marks, queue) = &mut *scratch;
+        marks.clear(self.tets.len());
+        marks.insert(t0 as usize);
         queue.clear();
         queue.push(t0);
         if stop(t0) {
@@ -476,8 +471,7 @@ impl Triangulation {
                     continue; // the face opposite v does not hold it
                 }
                 let nb = self.neigh[4 * t as usize + f];
-                if nb != NONE && marks[(nb >> 2) as usize] != ep {
-                    marks[(nb >> 2) as usize] = ep;
+                if nb != NONE && marks.insert((nb >> 2) as usize) {
                     queue.push(nb >> 2);
                     if stop(nb >> 2) {
                         return Some(nb >> 2);

@@ -7,10 +7,10 @@
 //! next), is evaluated in parallel, and is committed in its order. The
 //! batches depend on the list and the mesh only, so the mesh is the same
 //! on any number of threads.
-use crate::work::{Marks, Work};
+use crate::work::Work;
 use crate::{Improver, Outcome};
 use parafront_geom::P3;
-use parafront_mesh::PointId;
+use parafront_mesh::{Marks, PointId};
 use rayon::prelude::*;
 
 /// Tets in a batch at most (fixed: the batches, and so the order of

@@ -5,7 +5,7 @@
 //! which keeps `neigh` consistent without a global rebuild.
 use crate::quality::quality;
 use parafront_geom::P3;
-use parafront_mesh::{FaceRef, PointId, TetMesh, NO_FACE, TET_FACES};
+use parafront_mesh::{FaceRef, Marks, PointId, TetMesh, NO_FACE, TET_FACES};
 
 /// Vertex ids of a dead tet slot.
 pub(crate) const DEAD: [PointId; 4] = [PointId::from_raw(u32::MAX); 4];
@@ -72,43 +72,6 @@ pub(crate) struct Work<'m> {
     slots: Vec<u32>,
     used: Vec<bool>,
     cav: Vec<PointId>,
-}
-
-/// A set of indices that empties in O(1): an index is in it while its
-/// stamp is the current epoch (the tets a ball walk has reached, the
-/// points a batch holds).
-#[derive(Default)]
-pub(crate) struct Marks {
-    stamp: Vec<u32>,
-    epoch: u32,
-}
-
-impl Marks {
-    /// Empties the set, for indices below `n` from now on.
-    #[inline]
-    pub(crate) fn clear(&mut self, n: usize) {
-        self.epoch = self.epoch.wrapping_add(1);
-        if self.epoch == 0 {
-            self.stamp.iter_mut().for_each(|s| *s = 0);
-            self.epoch = 1;
-        }
-        if self.stamp.len() < n {
-            self.stamp.resize(n, 0);
-        }
-    }
-
-    /// Adds `i`; whether it was not in the set yet.
-    #[inline]
-    pub(crate) fn insert(&mut self, i: usize) -> bool {
-        let new = self.stamp[i] != self.epoch;
-        self.stamp[i] = self.epoch;
-        new
-    }
-
-    #[inline]
-    pub(crate) fn contains(&self, i: usize) -> bool {
-        self.stamp[i] == self.epoch
-    }
 }
 
 #[inline]

@@ -13,6 +13,7 @@
 //! - `check`, `check_against_surface`: all invariants, exact orientation.
 //! - [`quality`]: dihedral angles, radius and mean ratio, edge length vs size.
 //! - [`generate`]: structured box meshes for tests.
+//! - [`Marks`]: an index set that empties in O(1), for the walks.
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
@@ -22,6 +23,7 @@ pub mod compact;
 mod faces;
 pub mod generate;
 pub mod ids;
+mod marks;
 mod problem;
 pub mod quality;
 mod slices;
@@ -30,6 +32,7 @@ mod tetmesh;
 pub use adjacency::{face_neighbours, TopoError, MAX_TETS};
 pub use check::{CheckStats, SAMPLES, VOLUME_RTOL};
 pub use ids::{FaceRef, PointId, TetId, NO_FACE};
+pub use marks::Marks;
 pub use problem::{CheckError, MeshProblem, ProblemKind};
 pub use quality::{QualityReport, TetQuality};
 pub use tetmesh::{TetMesh, TET_FACES};

@@ -9,7 +9,7 @@ use crate::{RegionFilter, SizeMode, NO_PLACE};
 pub use api::{FrontError, FrontInput, FrontOptions, FrontResult, FrontStats, Partial};
 use parafront_geom::intersect::{shared_first, triangles_intersect};
 use parafront_geom::*;
-use parafront_mesh::TET_FACES;
+use parafront_mesh::{Marks, TET_FACES};
 use rustc_hash::FxHashMap;
 
 mod api;
@@ -239,9 +239,8 @@ struct Front<'a> {
     near_f: Vec<Near>,
     near_p: Vec<u32>,
     cands: Vec<(f64, u32)>,
-    /// Per point: the query that last saw it (dedups corners of faces).
-    stamp: Vec<u32>,
-    epoch: u32,
+    /// The points the close-face search has seen (dedups corners of faces).
+    seen: Marks,
 }
 
 /// Each of `g`'s ids' index in `tv`, or 4: by selects, not `position`
@@ -381,8 +380,7 @@ impl<'a> Front<'a> {
             near_f: Vec::new(),
             near_p: Vec::new(),
             cands: Vec::new(),
-            stamp: Vec::new(),
-            epoch: 0,
+            seen: Marks::default(),
         };
         if let SizeMode::Growth(c) = size {
             // §5: initial face sizes are multiplied by the growth factor.
@@ -445,14 +443,8 @@ impl<'a> Front<'a> {
     /// front points inside `q`. Front points are the corners of front
     /// faces, so one face query finds both.
     fn gather(&mut self, q: &Aabb, skip: u32, near_f: &mut Vec<Near>, near_p: &mut Vec<u32>) {
-        let mut stamp = std::mem::take(&mut self.stamp);
-        stamp.resize(self.pts.len(), 0);
-        self.epoch = self.epoch.wrapping_add(1);
-        if self.epoch == 0 {
-            stamp.iter_mut().for_each(|s| *s = 0);
-            self.epoch = 1;
-        }
-        let epoch = self.epoch;
+        let mut seen = std::mem::take(&mut self.seen);
+        seen.clear(self.pts.len());
         self.fgrid.query(q, |g, w| {
             let p = w.map(|i| self.pts[i as usize]);
             let bb = bbox(p);
@@ -460,19 +452,15 @@ impl<'a> Front<'a> {
                 return;
             }
             for k in 0..3 {
-                let s = &mut stamp[w[k] as usize];
-                if *s != epoch {
-                    *s = epoch;
-                    if q.contains(p[k]) {
-                        near_p.push(w[k]);
-                    }
+                if seen.insert(w[k] as usize) && q.contains(p[k]) {
+                    near_p.push(w[k]);
                 }
             }
             if g != skip {
                 near_f.push(Near { v: w, id: g, bb, p })
             }
         });
-        self.stamp = stamp;
+        self.seen = seen;
     }
 
     fn run(&mut self) -> Result<(), FrontError> {
@@ -622,7 +610,7 @@ impl<'a> Front<'a> {
         // The search structures go first: the output is built in place, so
         // the peak is the front's own.
         drop((self.heap, self.fmap, self.fgrid, self.input0));
-        drop((self.near_f, self.near_p, self.cands, self.stamp, self.stuck));
+        drop((self.near_f, self.near_p, self.cands, self.seen, self.stuck));
         let front: Vec<[u32; 3]> = self
             .prohibited
             .iter()
