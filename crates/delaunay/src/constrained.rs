@@ -36,34 +36,30 @@ impl Triangulation {
         self.pts.push(p);
         self.vtet.push(NONE);
         let mut cav = Vec::new();
-        let ep = self.new_epoch();
-        if self
-            .constrained_cavity(id, t0, protect, &mut cav, ep)
-            .is_none()
-        {
+        self.new_cavity();
+        if self.constrained_cavity(id, t0, protect, &mut cav).is_none() {
             for &t in &cav {
-                self.mark[t as usize] = 0;
+                self.mark.remove(t as usize);
             }
             self.pts.pop();
             self.vtet.pop();
             return None;
         }
-        self.replace_by_cones(id, &cav, ep);
+        self.replace_by_cones(id, &cav);
         Some(id)
     }
 
-    /// The cavity of point `id` in `cav` (its tets marked `ep`).
+    /// The cavity of point `id` in `cav` (its tets marked).
     fn constrained_cavity(
         &mut self,
         id: u32,
         t0: u32,
         protect: &FxHashSet<[u32; 3]>,
         cav: &mut Vec<u32>,
-        ep: u32,
     ) -> Option<()> {
         let p = self.pts[id as usize];
         cav.push(t0);
-        self.mark[t0 as usize] = ep;
+        self.mark.insert(t0 as usize);
         // Grow: every tet that holds `p` (it may lie on a face or an edge),
         // and Bowyer-Watson's, never across a protected face.
         let mut i = 0;
@@ -72,7 +68,7 @@ impl Triangulation {
             i += 1;
             for f in 0..4 {
                 let nb = self.neigh[4 * t as usize + f];
-                if nb == NONE || self.mark[(nb >> 2) as usize] == ep {
+                if nb == NONE || self.mark.contains((nb >> 2) as usize) {
                     continue;
                 }
                 let u = nb >> 2;
@@ -87,7 +83,7 @@ impl Triangulation {
                 {
                     continue;
                 }
-                self.mark[u as usize] = ep;
+                self.mark.insert(u as usize);
                 cav.push(u);
             }
         }
@@ -100,7 +96,7 @@ impl Triangulation {
                 for f in 0..4 {
                     let nb = self.neigh[4 * t as usize + f];
                     let w = TET_FACES[f].map(|k| tv[k]);
-                    let inside = nb != NONE && self.mark[(nb >> 2) as usize] == ep;
+                    let inside = nb != NONE && self.mark.contains((nb >> 2) as usize);
                     if inside {
                         // A protected face between two cavity tets: the
                         // one that does not hold `p` goes.
@@ -135,7 +131,7 @@ impl Triangulation {
                         .into_iter()
                         .filter(|&s| self.tets[s as usize].contains(&v))
                         .collect();
-                    if around.iter().all(|&s| self.mark[s as usize] == ep) {
+                    if around.iter().all(|&s| self.mark.contains(s as usize)) {
                         let out = around.iter().copied().find(|&s| !self.holds(s, p));
                         drop.push(out.unwrap_or(t));
                     }
@@ -148,9 +144,9 @@ impl Triangulation {
                 if self.holds(t, p) {
                     return None;
                 }
-                self.mark[t as usize] = 0;
+                self.mark.remove(t as usize);
             }
-            cav.retain(|&t| self.mark[t as usize] == ep);
+            cav.retain(|&t| self.mark.contains(t as usize));
         }
     }
 }

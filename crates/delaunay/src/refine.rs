@@ -10,6 +10,7 @@ use crate::fill::Fill;
 use crate::flips::key3;
 use crate::tri::{Triangulation, NONE, TET_FACES};
 use parafront_geom::{add, cross, dist, dist2, dot, orient3d, scale, sub, P3};
+use parafront_mesh::Marks;
 use rustc_hash::FxHashMap;
 
 /// How far to refine.
@@ -201,7 +202,7 @@ impl Triangulation {
         tri.tets.clear();
         tri.neigh.clear();
         tri.alive.clear();
-        tri.mark.clear();
+        tri.mark = Marks::default();
         tri.vtet.iter_mut().for_each(|v| *v = NONE);
         let n = points.len() as u32;
         let mut open: FxHashMap<[u32; 3], u32> = FxHashMap::default();
@@ -239,19 +240,19 @@ impl Triangulation {
         Ok(tri)
     }
 
-    /// Shrink the cavity `cav` (marked `ep`) until `p` sees each of its
+    /// Shrink the cavity `cav` (marked) until `p` sees each of its
     /// boundary faces strictly from inside: a tet with a face it does not
     /// see leaves (the region's boundary is not to be crossed, so growing
     /// is no way out), then what is no longer joined to `t0`. `None` when
     /// `t0` itself has such a face (`p` on it).
-    fn shrink_to_star(&mut self, p: P3, t0: u32, cav: &mut Vec<u32>, ep: u32) -> Option<()> {
+    fn shrink_to_star(&mut self, p: P3, t0: u32, cav: &mut Vec<u32>) -> Option<()> {
         loop {
             let mut out = Vec::new();
             for &t in cav.iter() {
                 let tv = self.tets[t as usize];
                 let blind = (0..4).any(|f| {
                     let nb = self.neigh[4 * t as usize + f];
-                    (nb == NONE || self.mark[(nb >> 2) as usize] != ep) && {
+                    (nb == NONE || !self.mark.contains((nb >> 2) as usize)) && {
                         let w = TET_FACES[f].map(|k| self.pts[tv[k] as usize]);
                         flat_cone(w, p)
                     }
@@ -268,21 +269,21 @@ impl Triangulation {
             }
             // Unmark them, then keep what is still joined to `t0`.
             for &t in &out {
-                self.mark[t as usize] = 0;
+                self.mark.remove(t as usize);
             }
             let inside: Vec<u32> = cav
                 .iter()
                 .copied()
-                .filter(|&t| self.mark[t as usize] == ep)
+                .filter(|&t| self.mark.contains(t as usize))
                 .collect();
             for &t in &inside {
-                self.mark[t as usize] = 0;
+                self.mark.remove(t as usize);
             }
             let keep: rustc_hash::FxHashSet<u32> = inside.iter().copied().collect();
             cav.clear();
             cav.push(t0);
-            self.mark[t0 as usize] = ep;
-            self.grow_cavity(cav, ep, |_, u| keep.contains(&u));
+            self.mark.insert(t0 as usize);
+            self.grow_cavity(cav, |_, u| keep.contains(&u));
         }
     }
 
@@ -293,8 +294,8 @@ impl Triangulation {
         self.pts.push(x);
         self.vtet.push(NONE);
         match self.spaced_cavity(id, spacing) {
-            Some((cav, ep)) => {
-                self.replace_by_cones(id, &cav, ep);
+            Some(cav) => {
+                self.replace_by_cones(id, &cav);
                 Some(id)
             }
             None => {
@@ -306,10 +307,10 @@ impl Triangulation {
     }
 
     /// The Bowyer-Watson cavity of point `id` (stored, not inserted),
-    /// shrunk until star-shaped, and its epoch; `None` when the point lies
+    /// shrunk until star-shaped; `None` when the point lies
     /// outside the region or on a face of the tet that holds it, a corner
     /// would be dropped, or one is nearer than `spacing`.
-    fn spaced_cavity(&mut self, id: u32, spacing: f64) -> Option<(Vec<u32>, u32)> {
+    fn spaced_cavity(&mut self, id: u32, spacing: f64) -> Option<Vec<u32>> {
         let p = self.pts[id as usize];
         let t0 = self.locate(p, self.last)?;
         // `t0` stays in the cavity: its corners are checked at once, before
@@ -322,8 +323,8 @@ impl Triangulation {
             return None;
         }
         let mut cav = Vec::new();
-        let ep = self.conflict_region(id, t0, &mut cav);
-        self.shrink_to_star(p, t0, &mut cav, ep)?;
+        self.conflict_region(id, t0, &mut cav);
+        self.shrink_to_star(p, t0, &mut cav)?;
         // Every corner must stay on the cavity's boundary: in a region that
         // is not Delaunay (recovery flips, moved Steiner points) a cavity
         // can hold a point's whole star, and the cones would drop it.
@@ -334,7 +335,7 @@ impl Triangulation {
             corners.extend_from_slice(&tv);
             for (f, fv) in TET_FACES.iter().enumerate() {
                 let nb = self.neigh[4 * t as usize + f];
-                if nb == NONE || self.mark[(nb >> 2) as usize] != ep {
+                if nb == NONE || !self.mark.contains((nb >> 2) as usize) {
                     on_boundary.extend(fv.map(|j| tv[j]));
                 }
             }
@@ -347,7 +348,7 @@ impl Triangulation {
             && corners
                 .iter()
                 .all(|&v| dist(self.pts[v as usize], p) >= spacing);
-        ok.then_some((cav, ep))
+        ok.then_some(cav)
     }
 }
 

@@ -48,8 +48,8 @@ pub struct Triangulation {
     pub(crate) last: u32,
     // Scratch for insertion.
     conflict: Vec<u32>,
-    pub(crate) mark: Vec<u32>,
-    epoch: u32,
+    /// The tets of the cavity being built (one at a time).
+    pub(crate) mark: Marks,
     /// Scratch for [`Triangulation::star`]: the tet slots reached, and
     /// the walk's queue.
     star_mark: std::cell::RefCell<(Marks, Vec<u32>)>,
@@ -121,8 +121,7 @@ impl Triangulation {
             vtet: vec![NONE; n],
             last: 0,
             conflict: Vec::new(),
-            mark: vec![0],
-            epoch: 0,
+            mark: Marks::default(),
             star_mark: Default::default(),
             generation: 0,
             ring_memo: Default::default(),
@@ -235,14 +234,9 @@ impl Triangulation {
             .all(|fv| orient3d(tp[fv[0]], tp[fv[1]], tp[fv[2]], p) <= 0.0)
     }
 
-    pub(crate) fn new_epoch(&mut self) -> u32 {
-        self.epoch = self.epoch.wrapping_add(1);
-        if self.epoch == 0 {
-            self.mark.iter_mut().for_each(|m| *m = 0);
-            self.epoch = 1;
-        }
-        self.mark.resize(self.tets.len(), 0);
-        self.epoch
+    /// Empties the cavity marks for the next cavity.
+    pub(crate) fn new_cavity(&mut self) {
+        self.mark.clear(self.tets.len());
     }
 
     /// Bowyer-Watson: the tets whose perturbed circumsphere holds point
@@ -258,33 +252,31 @@ impl Triangulation {
             }
         }
         let mut cav = std::mem::take(&mut self.conflict);
-        let ep = self.conflict_region(id, t0, &mut cav);
-        self.star_cavity(id, &mut cav, ep)?;
-        self.replace_by_cones(id, &cav, ep);
+        self.conflict_region(id, t0, &mut cav);
+        self.star_cavity(id, &mut cav)?;
+        self.replace_by_cones(id, &cav);
         self.conflict = cav;
         Ok(())
     }
 
     /// The tets whose perturbed circumsphere holds point `id`, grown from
-    /// `t0` (which holds it) into `cav`, marked with the epoch returned.
-    pub(crate) fn conflict_region(&mut self, id: u32, t0: u32, cav: &mut Vec<u32>) -> u32 {
+    /// `t0` (which holds it) into `cav`, marked.
+    pub(crate) fn conflict_region(&mut self, id: u32, t0: u32, cav: &mut Vec<u32>) {
         let p = self.pts[id as usize];
-        let ep = self.new_epoch();
+        self.new_cavity();
         cav.clear();
         cav.push(t0);
-        self.mark[t0 as usize] = ep;
-        self.grow_cavity(cav, ep, |tri, u| {
+        self.mark.insert(t0 as usize);
+        self.grow_cavity(cav, |tri, u| {
             in_sphere_sos(tri.tets[u as usize], tri.tet_points(u), id, p)
         });
-        ep
     }
 
-    /// Grow the cavity `cav` (its tets marked `ep`), breadth first, across
+    /// Grow the cavity `cav` (its tets marked), breadth first, across
     /// faces to every tet `accept` takes.
     pub(crate) fn grow_cavity(
         &mut self,
         cav: &mut Vec<u32>,
-        ep: u32,
         accept: impl Fn(&Triangulation, u32) -> bool,
     ) {
         let mut i = 0;
@@ -293,26 +285,21 @@ impl Triangulation {
             i += 1;
             for f in 0..4 {
                 let nb = self.neigh[4 * t as usize + f];
-                if nb == NONE || self.mark[(nb >> 2) as usize] == ep {
+                if nb == NONE || self.mark.contains((nb >> 2) as usize) {
                     continue;
                 }
                 let u = nb >> 2;
                 if accept(self, u) {
-                    self.mark[u as usize] = ep;
+                    self.mark.insert(u as usize);
                     cav.push(u);
                 }
             }
         }
     }
 
-    /// Grow the cavity `cav` (marked `ep`) until point `id` sees every face
-    /// of its boundary strictly from inside.
-    pub(crate) fn star_cavity(
-        &mut self,
-        id: u32,
-        cav: &mut Vec<u32>,
-        ep: u32,
-    ) -> Result<(), InsertError> {
+    /// Grow the cavity `cav` (marked) until point `id` sees every face of
+    /// its boundary strictly from inside.
+    pub(crate) fn star_cavity(&mut self, id: u32, cav: &mut Vec<u32>) -> Result<(), InsertError> {
         let p = self.pts[id as usize];
         loop {
             let mut grew = false;
@@ -322,7 +309,7 @@ impl Triangulation {
                 i += 1;
                 for f in 0..4 {
                     let nb = self.neigh[4 * t as usize + f];
-                    if nb != NONE && self.mark[(nb >> 2) as usize] == ep {
+                    if nb != NONE && self.mark.contains((nb >> 2) as usize) {
                         continue;
                     }
                     let tv = self.tets[t as usize];
@@ -334,7 +321,7 @@ impl Triangulation {
                         return Err(InsertError::Outside(p));
                     }
                     let u = nb >> 2;
-                    self.mark[u as usize] = ep;
+                    self.mark.insert(u as usize);
                     cav.push(u);
                     grew = true;
                 }
@@ -345,9 +332,9 @@ impl Triangulation {
         }
     }
 
-    /// Replace the cavity `cav` (marked `ep`, star-shaped about point `id`)
-    /// by the cones from `id` over its boundary faces.
-    pub(crate) fn replace_by_cones(&mut self, id: u32, cav: &[u32], ep: u32) {
+    /// Replace the cavity `cav` (marked, star-shaped about point `id`) by
+    /// the cones from `id` over its boundary faces.
+    pub(crate) fn replace_by_cones(&mut self, id: u32, cav: &[u32]) {
         // Boundary faces: (outer face ref or NONE, the face's corners as
         // seen from the cavity, outward).
         let mut bnd: Vec<(u32, [u32; 3])> = Vec::new();
@@ -355,7 +342,7 @@ impl Triangulation {
             let tv = self.tets[t as usize];
             for f in 0..4 {
                 let nb = self.neigh[4 * t as usize + f];
-                if nb != NONE && self.mark[(nb >> 2) as usize] == ep {
+                if nb != NONE && self.mark.contains((nb >> 2) as usize) {
                     continue;
                 }
                 bnd.push((nb, TET_FACES[f].map(|k| tv[k])));
@@ -409,7 +396,7 @@ impl Triangulation {
             self.tets.push(tv);
             self.alive.push(true);
             self.neigh.extend_from_slice(&[NONE; 4]);
-            self.mark.push(0);
+            self.mark.grow(self.tets.len());
             t
         }
     }

@@ -33,6 +33,21 @@ impl Marks {
         new
     }
 
+    /// Takes `i` out of the set.
+    #[inline]
+    pub fn remove(&mut self, i: usize) {
+        self.stamp[i] = 0;
+    }
+
+    /// Makes room for indices below `n`, the set unchanged (a store that
+    /// grows between clears).
+    #[inline]
+    pub fn grow(&mut self, n: usize) {
+        if self.stamp.len() < n {
+            self.stamp.resize(n, 0);
+        }
+    }
+
     /// Whether `i` is in the set.
     #[inline]
     pub fn contains(&self, i: usize) -> bool {
@@ -66,6 +81,23 @@ mod tests {
         m.clear(2);
         assert!(!m.contains(2), "emptied");
         assert!(m.insert(3), "index 3 is still there after a smaller clear");
+        m.check().unwrap();
+    }
+
+    /// A removed index is out until inserted again; `grow` makes room and
+    /// keeps what is in (the Delaunay kernel adds tets to a cavity's
+    /// store while the cavity stands).
+    #[test]
+    fn remove_takes_one_out_and_grow_keeps_the_set() {
+        let mut m = Marks::default();
+        m.clear(2);
+        m.insert(0);
+        m.insert(1);
+        m.remove(0);
+        assert!(!m.contains(0) && m.contains(1));
+        m.grow(5);
+        assert!(m.contains(1), "grow keeps the set");
+        assert!(!m.contains(4) && m.insert(4));
         m.check().unwrap();
     }
 
