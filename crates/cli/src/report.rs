@@ -23,16 +23,7 @@ impl ProgressLine {
             );
             let t0 = Instant::now();
             while !flag.load(Ordering::Relaxed) {
-                let tets = p.tets();
-                let rate = tets as f64 / t0.elapsed().as_secs_f64().max(1e-9);
-                let mut msg = format!("{tets} tets, front {} faces, {rate:.0} tets/s", p.front());
-                if p.rounds() > 0 {
-                    msg.push_str(&format!(", recovery round {}", p.rounds()));
-                }
-                if p.fills() > 0 {
-                    msg.push_str(&format!(", constrained fill {}", p.fills()));
-                }
-                bar.set_message(msg);
+                bar.set_message(progress_message(&p, t0.elapsed().as_secs_f64()));
                 bar.tick();
                 std::thread::sleep(std::time::Duration::from_millis(100));
             }
@@ -49,6 +40,29 @@ impl ProgressLine {
         if let Some(h) = self.handle.take() {
             let _ = h.join();
         }
+    }
+}
+
+/// The progress line's text, `secs` into the run.
+fn progress_message(p: &parafront_front::Progress, secs: f64) -> String {
+    use parafront_front::Phase;
+    let tets = p.tets();
+    match p.phase() {
+        Phase::Meshing => {
+            let rate = tets as f64 / secs.max(1e-9);
+            let mut msg = format!("{tets} tets, front {} faces, {rate:.0} tets/s", p.front());
+            if p.rounds() > 0 {
+                msg.push_str(&format!(", recovery round {}", p.rounds()));
+            }
+            if p.fills() > 0 {
+                msg.push_str(&format!(", constrained fill {}", p.fills()));
+            }
+            msg
+        }
+        Phase::Improving => {
+            "meshed; improving the tets (swaps, collapses, smoothing, point moves)".to_string()
+        }
+        Phase::Checking => "improved; checking the mesh".to_string(),
     }
 }
 
@@ -200,4 +214,26 @@ pub(crate) fn peak_memory_bytes() -> Option<u64> {
     let line = s.lines().find(|l| l.starts_with("VmHWM:"))?;
     let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
     Some(kb * 1024)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::progress_message;
+    use parafront_front::{Phase, Progress};
+
+    /// After the front, the line says what the run does instead of a
+    /// front count that no longer moves.
+    #[test]
+    fn the_progress_line_names_the_phase() {
+        let p = Progress::default();
+        let m = progress_message(&p, 1.0);
+        assert!(m.contains("tets/s") && m.contains("front"), "{m}");
+        p.set_phase(Phase::Improving);
+        let m = progress_message(&p, 1.0);
+        assert!(m.contains("improving") && !m.contains("tets/s"), "{m}");
+        p.set_phase(Phase::Checking);
+        assert!(progress_message(&p, 1.0).contains("checking"));
+        p.set_phase(Phase::Meshing);
+        assert!(progress_message(&p, 1.0).contains("tets/s"));
+    }
 }

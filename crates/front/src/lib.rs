@@ -20,19 +20,46 @@ pub use crate::core::{
     DEFAULT_FILL_AFTER, MAX_GROWTH_PER_TET,
 };
 
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::atomic::{AtomicU64, AtomicU8, Ordering};
 
 /// Counters a front updates as it works, for a progress display on another
-/// thread. Relaxed atomics: a display needs no ordering.
+/// thread, and the run's phase, which the pipeline sets. Relaxed atomics:
+/// a display needs no ordering.
 #[derive(Debug, Default)]
 pub struct Progress {
     tets: AtomicU64,
     front: AtomicU64,
     rounds: AtomicU64,
     fills: AtomicU64,
+    phase: AtomicU8,
+}
+
+/// What a run is doing, for a progress display: after the front, the
+/// improvement (§9) and the final check can take as long as it did (a CAD
+/// part whose region went to the fill: 12-40 s of improvement).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Phase {
+    /// The front, its fills, the DDG and the passes.
+    Meshing,
+    /// Mesh improvement (§9).
+    Improving,
+    /// The validity check of the result.
+    Checking,
 }
 
 impl Progress {
+    /// The run's phase.
+    pub fn phase(&self) -> Phase {
+        match self.phase.load(Ordering::Relaxed) {
+            1 => Phase::Improving,
+            2 => Phase::Checking,
+            _ => Phase::Meshing,
+        }
+    }
+    /// Sets the run's phase (the pipeline, as it goes).
+    pub fn set_phase(&self, p: Phase) {
+        self.phase.store(p as u8, Ordering::Relaxed);
+    }
     /// Tets made so far (recovery's removals are not subtracted).
     pub fn tets(&self) -> u64 {
         self.tets.load(Ordering::Relaxed)

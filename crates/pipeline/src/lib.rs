@@ -147,6 +147,13 @@ pub struct MeshOptions {
 
 impl MeshOptions {
     /// Hands freed memory back, where [`MeshOptions::release_memory`] says how.
+    /// Tells the progress display, if any, what the run does now.
+    pub(crate) fn note_phase(&self, p: parafront_front::Phase) {
+        if let Some(pr) = &self.progress {
+            pr.set_phase(p);
+        }
+    }
+
     pub(crate) fn release(&self) {
         if let Some(f) = self.release_memory {
             f();
@@ -476,6 +483,7 @@ fn mesh_sized<C: Comm>(
     opts.release();
 
     if opts.optimize > 0 {
+        opts.note_phase(parafront_front::Phase::Improving);
         // The report before improvement is the improvement's cost.
         let t0 = Instant::now();
         sum.quality_before = Some(QualityReport::new(&mesh));
@@ -492,6 +500,7 @@ fn mesh_sized<C: Comm>(
         opts.release();
     }
 
+    opts.note_phase(parafront_front::Phase::Checking);
     let t0 = Instant::now();
     // Improvement keeps the adjacency up to date; the check below compares
     // every entry with its own face table, so a complete one is not built

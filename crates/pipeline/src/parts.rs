@@ -178,6 +178,7 @@ pub(crate) fn finish_pieces<C: Comm>(
     mut sum: Summary,
 ) -> Result<(TetMesh, Summary), MeshError> {
     if opts.optimize > 0 {
+        opts.note_phase(parafront_front::Phase::Improving);
         let t0 = Instant::now();
         let region: Vec<u32> = fronts.iter().map(|rf| rf.region_id).collect();
         let io = parafront_improve::ImproveOptions {
@@ -191,6 +192,7 @@ pub(crate) fn finish_pieces<C: Comm>(
         sum.push(Stage::Improve, t0.elapsed().as_secs_f64());
         opts.release();
     }
+    opts.note_phase(parafront_front::Phase::Checking);
     let t0 = Instant::now();
     // Region by region, one piece per part held here.
     let held = comm.owned().len();
