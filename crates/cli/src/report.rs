@@ -46,9 +46,9 @@ impl ProgressLine {
 /// The progress line's text, `secs` into the run.
 fn progress_message(p: &parafront_front::Progress, secs: f64) -> String {
     use parafront_front::Phase;
-    let tets = p.tets();
     match p.phase() {
         Phase::Meshing => {
+            let tets = p.tets();
             let rate = tets as f64 / secs.max(1e-9);
             let mut msg = format!("{tets} tets, front {} faces, {rate:.0} tets/s", p.front());
             if p.rounds() > 0 {

@@ -146,7 +146,6 @@ pub struct MeshOptions {
 }
 
 impl MeshOptions {
-    /// Hands freed memory back, where [`MeshOptions::release_memory`] says how.
     /// Tells the progress display, if any, what the run does now.
     pub(crate) fn note_phase(&self, p: parafront_front::Phase) {
         if let Some(pr) = &self.progress {
@@ -154,6 +153,7 @@ impl MeshOptions {
         }
     }
 
+    /// Hands freed memory back, where [`MeshOptions::release_memory`] says how.
     pub(crate) fn release(&self) {
         if let Some(f) = self.release_memory {
             f();
