@@ -4,11 +4,22 @@
 //! holds, the front points a close-face search has seen).
 
 /// An index set over `0..n` whose [`Marks::clear`] costs nothing but a
-/// new epoch (all stamps are reset only when the epoch wraps).
-#[derive(Clone, Debug, Default)]
+/// new epoch (all stamps are reset only when the epoch wraps). Stamp 0 is
+/// never an epoch, so unstamped and removed indices are never in it.
+#[derive(Clone, Debug)]
 pub struct Marks {
     stamp: Vec<u32>,
     epoch: u32,
+}
+
+impl Default for Marks {
+    /// Empty, with room for no index (see [`Marks::clear`], [`Marks::grow`]).
+    fn default() -> Self {
+        Marks {
+            stamp: Vec::new(),
+            epoch: 1,
+        }
+    }
 }
 
 impl Marks {
@@ -81,6 +92,19 @@ mod tests {
         m.clear(2);
         assert!(!m.contains(2), "emptied");
         assert!(m.insert(3), "index 3 is still there after a smaller clear");
+        m.check().unwrap();
+    }
+
+    /// A new set is empty before any clear, also where `grow` made room
+    /// (with the epoch at 0 every unstamped index was in it).
+    #[test]
+    fn a_new_set_is_empty() {
+        let mut m = Marks::default();
+        m.grow(3);
+        assert!((0..3).all(|i| !m.contains(i)));
+        assert!(m.insert(1));
+        m.remove(1);
+        assert!(!m.contains(1));
         m.check().unwrap();
     }
 
