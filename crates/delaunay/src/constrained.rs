@@ -38,9 +38,7 @@ impl Triangulation {
         let mut cav = Vec::new();
         self.new_cavity();
         if self.constrained_cavity(id, t0, protect, &mut cav).is_none() {
-            for &t in &cav {
-                self.mark.remove(t as usize);
-            }
+            // Its marks go with the next cavity's clear.
             self.pts.pop();
             self.vtet.pop();
             return None;
