@@ -83,6 +83,19 @@ impl Default for FillOptions {
     }
 }
 
+impl FillOptions {
+    /// The fill of a whole region's surface (GDT's start, §2): straight to
+    /// the conforming fill (`segments_first`), with the default split
+    /// budget. The front's region fills and the pipeline's fallback use
+    /// it, so that they make the same fill.
+    pub fn whole_region() -> FillOptions {
+        FillOptions {
+            segments_first: true,
+            ..FillOptions::default()
+        }
+    }
+}
+
 /// How a cavity was closed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum FillMethod {

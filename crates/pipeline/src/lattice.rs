@@ -1,8 +1,13 @@
-//! Improvement (§9) around the lattice (§2): the lattice's inner tets are
-//! ideal and their points frozen, so they are set aside while the rest is
-//! improved, and cost it nothing.
+//! The lattice (§2's optimal space-filling tets) in the pipeline: built in
+//! each region, counted in the summary, and improvement (§9) around it:
+//! the lattice's inner tets are ideal and their points frozen, so they are
+//! set aside while the rest is improved, and cost it nothing.
+use crate::{LatticeMode, MeshOptions, RegionFront, Stage, Summary};
 use parafront_improve::{improve, ImproveOptions, ImproveStats};
+use parafront_lattice::{Lattice, LatticeOptions};
 use parafront_mesh::{PointId, TetMesh, TopoError};
+use parafront_size::{SizeField, Sizing};
+use std::time::Instant;
 
 /// Improves `mesh`, whose first `n_surface` points are the surface's and
 /// `inner` (ids) the lattice's inner points, all frozen. The inner points
@@ -66,4 +71,61 @@ pub(crate) fn improve_around_lattice(
     st.tets_before += aside.len();
     st.tets_after += aside.len();
     Ok(st)
+}
+
+/// §2's optimal space-filling tets in region `rf` (its surface points
+/// `points`), or none where `opts.lattice` turns them off or the size
+/// field has no bound.
+pub(crate) fn region_lattice(
+    points: &[parafront_geom::P3],
+    point_size: &[f64],
+    rf: &RegionFront,
+    sizing: &Sizing,
+    opts: &MeshOptions,
+    sum: &mut Summary,
+) -> Lattice {
+    let t_lat = Instant::now();
+    let use_lattice = match opts.lattice {
+        LatticeMode::On => true,
+        LatticeMode::Off => false,
+        LatticeMode::Auto => sizing.hmax().is_finite(),
+    };
+    let lattice = if use_lattice {
+        parafront_lattice::build(
+            points,
+            point_size,
+            &rf.faces,
+            &|p| sizing.size(p),
+            &LatticeOptions::default(),
+        )
+    } else {
+        Lattice::default()
+    };
+    tracing::debug!(
+        region = rf.region_id,
+        tets = lattice.tets.len(),
+        seconds = t_lat.elapsed().as_secs_f64(),
+        "lattice"
+    );
+    if !lattice.tets.is_empty() {
+        sum.push(Stage::Lattice, t_lat.elapsed().as_secs_f64());
+    }
+    lattice
+}
+
+/// The lattice's share of the summary, and its inner points (the region's
+/// first new points, from `base`), which improvement leaves alone.
+pub(crate) fn note_lattice(
+    lattice: &Lattice,
+    base: u32,
+    sum: &mut Summary,
+    lattice_inner: &mut Vec<u32>,
+) {
+    lattice_inner.extend(
+        (0..lattice.points.len() as u32)
+            .filter(|&k| lattice.interior[k as usize])
+            .map(|k| base + k),
+    );
+    sum.lattice_tets += lattice.tets.len();
+    sum.lattice_cells += lattice.cells;
 }

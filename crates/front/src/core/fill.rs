@@ -148,10 +148,7 @@ impl<'a> Front<'a> {
     pub(super) fn fill_early(&mut self) -> bool {
         self.early = false;
         let faces = std::mem::take(&mut self.input0);
-        let fopts = FillOptions {
-            segments_first: true,
-            ..FillOptions::default()
-        };
+        let fopts = FillOptions::whole_region();
         tracing::debug!(
             faces = faces.len(),
             "front stalled at once: constrained fill of the region"
@@ -228,10 +225,7 @@ impl<'a> Front<'a> {
             faces = faces.len(),
             "front stalled on much of the region: constrained fill of the region, refined"
         );
-        let fopts = FillOptions {
-            segments_first: true,
-            ..FillOptions::default()
-        };
+        let fopts = FillOptions::whole_region();
         let Some(fill) = self.whole_fill(&faces, &fopts, true) else {
             return false;
         };

@@ -1,0 +1,195 @@
+//! Step 3 on one process: the serial front (§4) on each region, its
+//! initial front joined by §2's lattice, and the whole region's
+//! constrained fill refined to the size field (GDT, §2) where the front
+//! hands the region over or cannot close it. Also the helpers that put a
+//! region's points and tets into the mesh, which the parts' path shares.
+use super::*;
+
+/// The serial front (§4) on each region, appended to `mesh`; the lattice's
+/// inner points, for improvement to leave alone.
+pub(crate) fn mesh_serial(
+    s: &Surface,
+    fronts: &[RegionFront],
+    sizing: &Sizing,
+    opts: &MeshOptions,
+    mesh: &mut TetMesh,
+    sum: &mut Summary,
+) -> Result<Vec<u32>, MeshError> {
+    let mut lattice_inner = Vec::new();
+    for rf in fronts {
+        serial_region(s, rf, sizing, opts, mesh, sum, &mut lattice_inner)?;
+    }
+    Ok(lattice_inner)
+}
+
+/// The serial front on region `r`, appended to `mesh`.
+pub(crate) fn serial_region(
+    s: &Surface,
+    rf: &RegionFront,
+    sizing: &Sizing,
+    opts: &MeshOptions,
+    mesh: &mut TetMesh,
+    sum: &mut Summary,
+    lattice_inner: &mut Vec<u32>,
+) -> Result<(), MeshError> {
+    let field = |p| sizing.size(p);
+    let (points, point_size) = region_points(s, sizing, rf);
+    // §2's optimal space-filling tets: the lattice's points follow the
+    // surface's, its outer faces join the initial front.
+    let n_in = points.len() as u32;
+    let lattice = region_lattice(&points, &point_size, rf, sizing, opts, sum);
+    let with_lattice = |(mut points, mut point_size): (Vec<parafront_geom::P3>, Vec<f64>)| {
+        points.extend_from_slice(&lattice.points);
+        point_size.extend_from_slice(&lattice.size);
+        let mut faces = rf.faces.clone();
+        faces.extend(lattice.faces.iter().map(|f| f.map(|v| v + n_in)));
+        FrontInput {
+            points,
+            point_size,
+            faces,
+        }
+    };
+    let mut input = Some(with_lattice((points, point_size)));
+    let region = rf.region_id as usize;
+    // With a lattice (§2), a region the front stalls on at once is handed
+    // back rather than filled in the front: its whole surface is filled
+    // here, the lattice's points seeding the refinement; where that fails,
+    // the front runs again and fills or recovers in place.
+    let mut hand_over = !lattice.faces.is_empty();
+    let res = loop {
+        let input = input
+            .take()
+            .unwrap_or_else(|| with_lattice(region_points(s, sizing, rf)));
+        let res = advance(
+            input,
+            SizeMode::Field(&field),
+            &parafront_front::Everywhere,
+            &FrontOptions {
+                progress: opts.progress.clone(),
+                keep_partial: opts.debug_partial,
+                fill_after: opts.fill_after,
+                fill_early: true,
+                hand_over,
+                ..FrontOptions::default()
+            },
+        );
+        if !matches!(res, Err(FrontError::HandOver)) {
+            break res;
+        }
+        if let Some((all, tets)) = fill_whole(s, sizing, rf, &lattice.points) {
+            append_region(mesh, rf, &all, &tets);
+            sum.regions_refined.push(region);
+            sum.fill_tets += tets.len();
+            return Ok(());
+        }
+        hand_over = false;
+    };
+    let res = match res {
+        Ok(r) => r,
+        // The front could not close the region: the constrained fill of its
+        // whole surface, refined to the size field by Delaunay insertion
+        // (GDT, §2), unless a debug dump was asked for.
+        Err(e @ FrontError::Stuck { .. }) if !opts.debug_partial => {
+            let Some((all, tets)) = fill_whole(s, sizing, rf, &lattice.points) else {
+                return Err(MeshError::Front { region, source: e });
+            };
+            tracing::warn!(
+                region,
+                tets = tets.len(),
+                "the front could not close the region: filled whole by the constrained fill"
+            );
+            append_region(mesh, rf, &all, &tets);
+            sum.regions_filled.push(region);
+            sum.fill_tets += tets.len();
+            return Ok(());
+        }
+        Err(e) => return Err(MeshError::Front { region, source: e }),
+    };
+    let mut tets = res.tets;
+    tets.extend(lattice.tets.iter().map(|t| t.map(|v| v + n_in)));
+    let base = append_region(mesh, rf, &res.points, &tets);
+    note_lattice(&lattice, base, sum, lattice_inner);
+    sum.recovery_rounds += res.stats.recovery_rounds;
+    sum.tets_removed += res.stats.tets_removed;
+    sum.cavities_filled += res.stats.cavities_filled;
+    sum.fill_tets += res.stats.fill_tets;
+    if res.stats.regions_refined > 0 {
+        sum.regions_refined.push(region);
+    }
+    Ok(())
+}
+
+/// Region `rf`'s whole surface filled by the constrained fill, refined to
+/// the size field by Delaunay insertion (GDT, §2; `seeds`, a lattice's
+/// points, go in first): its points and tets, or `None` where the fill
+/// fails. The fill is valid, so refinement takes it; were it not, the fill
+/// as it is still is a mesh.
+pub(crate) fn fill_whole(
+    s: &Surface,
+    sizing: &Sizing,
+    rf: &RegionFront,
+    seeds: &[parafront_geom::P3],
+) -> Option<(Vec<parafront_geom::P3>, Vec<[u32; 4]>)> {
+    let field = |p| sizing.size(p);
+    // The front took the points; this path is rare, so they are gathered
+    // again rather than copied on every run.
+    let (mut points, _) = region_points(s, sizing, rf);
+    let fill = parafront_delaunay::fill_cavity(
+        &points,
+        &rf.faces,
+        &parafront_delaunay::FillOptions::whole_region(),
+    )
+    .ok()?;
+    let opts = parafront_delaunay::RefineOptions::default();
+    let fill = parafront_delaunay::refine_fill(&points, &fill, seeds, &field, &opts)
+        .unwrap_or_else(|err| {
+            tracing::warn!(region = rf.region_id, %err, "the region's fill was not refined");
+            fill
+        });
+    points.extend_from_slice(&fill.steiner);
+    Some((points, fill.tets))
+}
+
+/// A region's surface points, in its local order, and their sizes (AG3).
+pub(crate) fn region_points(
+    s: &Surface,
+    sizing: &Sizing,
+    rf: &RegionFront,
+) -> (Vec<parafront_geom::P3>, Vec<f64>) {
+    let h = sizing.surface_point_sizes();
+    rf.points
+        .iter()
+        .map(|&i| (s.points[i as usize], h[i as usize]))
+        .unzip()
+}
+
+/// The mesh id of a region's local point `p`: its surface points come
+/// first (`rf.points`, in order), then its new points, which were appended
+/// to the mesh from `base` on.
+pub(crate) fn global_id(rf: &RegionFront, base: u32, p: u32) -> u32 {
+    let n_in = rf.points.len();
+    if (p as usize) < n_in {
+        rf.points[p as usize]
+    } else {
+        base + p - n_in as u32
+    }
+}
+
+/// Appends one region's points and tets (local ids) to `mesh`; returns the
+/// `base` of its new points for [`global_id`].
+pub(crate) fn append_region(
+    mesh: &mut TetMesh,
+    rf: &RegionFront,
+    points: &[parafront_geom::P3],
+    tets: &[[u32; 4]],
+) -> u32 {
+    let base = mesh.points.len() as u32;
+    mesh.points.extend_from_slice(&points[rf.points.len()..]);
+    mesh.tets.extend(
+        tets.iter()
+            .map(|t| t.map(|p| PointId::from_raw(global_id(rf, base, p)))),
+    );
+    mesh.region
+        .extend(std::iter::repeat_n(rf.region_id, tets.len()));
+    base
+}
