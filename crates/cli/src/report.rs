@@ -144,6 +144,13 @@ pub(crate) fn print_summary(sum: &Summary) {
             sum.fill_tets
         );
     }
+    if sum.fills_failed > 0 {
+        println!(
+            "constrained fill: {} cavit{} left open by it (grown, recovered, or filled with the region's surface)",
+            sum.fills_failed,
+            if sum.fills_failed == 1 { "y" } else { "ies" },
+        );
+    }
     if !sum.regions_refined.is_empty() {
         let s = if sum.regions_refined.len() == 1 {
             ""

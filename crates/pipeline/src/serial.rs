@@ -113,6 +113,7 @@ pub(crate) fn serial_region(
     sum.tets_removed += res.stats.tets_removed;
     sum.cavities_filled += res.stats.cavities_filled;
     sum.fill_tets += res.stats.fill_tets;
+    sum.fills_failed += res.stats.fills_failed;
     if res.stats.regions_refined > 0 {
         sum.regions_refined.push(region);
     }

@@ -111,6 +111,9 @@ pub struct Summary {
     pub cavities_filled: usize,
     /// See `cavities_filled`.
     pub fill_tets: usize,
+    /// Cavities the fill was given and could not close; they grew, went
+    /// to recovery, or gave way to the fill of their region's surface.
+    pub fills_failed: usize,
     /// Tets and cubes of the optimal space-filling lattice (§2).
     pub lattice_tets: usize,
     /// See `lattice_tets`.

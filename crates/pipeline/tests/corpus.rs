@@ -2,7 +2,8 @@
 //! PARAFRONT_GEOMETRY is unset). Each mesh must keep its surface and fill it
 //! exactly. Not in the list: the two largest models (boot, skull: about a
 //! minute each).
-use parafront_pipeline::{mesh_surface, MeshOptions, Stage};
+use parafront_mesh::TetMesh;
+use parafront_pipeline::{mesh_surface, MeshOptions, Stage, Summary};
 use parafront_surface::read::read_surface;
 use std::path::PathBuf;
 
@@ -14,6 +15,19 @@ fn corpus() -> Option<PathBuf> {
             None
         }
     }
+}
+
+/// `file` meshed at `--size h`, checked against its surface: the surface's
+/// triangle and point counts, the mesh's tets and points, and the summary.
+fn mesh_sized(file: &str, h: f64) -> Option<(usize, usize, TetMesh, Summary)> {
+    let dir = corpus()?;
+    let s = read_surface(&dir.join(file)).unwrap_or_else(|e| panic!("{file}: {e}"));
+    let mut o = MeshOptions::default();
+    o.size.h = Some(h);
+    let (m, summary) = mesh_surface(&s, &o).unwrap_or_else(|e| panic!("{file} at size {h}: {e}"));
+    m.check_against_surface(&s.tris)
+        .unwrap_or_else(|e| panic!("{file} at size {h}: invalid mesh: {e}"));
+    Some((s.tris.len(), s.points.len(), m, summary))
 }
 
 fn mesh_file(file: &str) {
@@ -102,15 +116,27 @@ fn tray_at_a_fortieth_of_its_size() {
     // to 62 long: the front leaves thin cracks (1-3 % as thick as their
     // faces are long) that the fill closed only once its flips were
     // nested (a flip blocked by an edge removes that edge first).
-    let Some(dir) = corpus() else { return };
-    let s = read_surface(&dir.join("1002_tray_bottom.STL")).unwrap();
-    let mut o = MeshOptions::default();
-    o.size.h = Some(8.875);
-    let (m, summary) = mesh_surface(&s, &o).expect("the tray at size 8.875 meshes");
-    m.check_against_surface(&s.tris).expect("valid");
+    let Some((tris, _, m, summary)) = mesh_sized("1002_tray_bottom.STL", 8.875) else {
+        return;
+    };
     assert!(summary.cavities_filled > 0, "the fill closed cracks");
     assert!(summary.regions_filled.is_empty());
-    assert!(m.tets.len() > s.tris.len(), "{} tets", m.tets.len());
+    assert!(m.tets.len() > tris, "{} tets", m.tets.len());
+}
+
+#[test]
+fn round_at_a_size_its_front_cannot_meet() {
+    // `--size 0.4` on round.stl (side needles 8.7 long, 0.23 wide): the
+    // front stalls with one cavity of 15,748 faces for the surface's 1,120.
+    // The region's surface goes to the fill at once; the fill of that
+    // cavity, tried first, failed after 4-10 s, then the same fill came.
+    let Some((_, _, _, summary)) = mesh_sized("round.stl", 0.4) else {
+        return;
+    };
+    assert_eq!(summary.regions_refined, vec![1]);
+    assert!(summary.regions_filled.is_empty());
+    assert_eq!(summary.recovery_rounds, 0);
+    assert_eq!(summary.fills_failed, 0, "no cavity fill was tried");
 }
 
 #[test]
@@ -120,21 +146,21 @@ fn hinge_at_a_twentieth_of_its_size() {
     // goes to the constrained fill, its edges recovered first and kept
     // (TetGen's order), then refined to the size. Before, the fill failed
     // on the whole surface too and the run ended with an error.
-    let Some(dir) = corpus() else { return };
-    let s = read_surface(&dir.join("hinge.stl")).unwrap();
-    let mut o = MeshOptions::default();
-    o.size.h = Some(2.5);
-    let (m, summary) = mesh_surface(&s, &o).expect("the hinge at size 2.5 meshes");
-    m.check_against_surface(&s.tris).expect("valid");
+    let Some((_, surface_points, m, summary)) = mesh_sized("hinge.stl", 2.5) else {
+        return;
+    };
     // At the front's first stall, with no recovery round before it (the
     // fill has a tet flat in floating point; refused, it cost 7 s of
     // recovery that never closed, then the pipeline made the same fill).
     assert_eq!(summary.regions_refined, vec![1]);
     assert!(summary.regions_filled.is_empty());
     assert_eq!(summary.recovery_rounds, 0);
+    // Its cavities hold 1.2 times the surface's faces in all: the fill
+    // tried the cavities first, and left one open.
+    assert!(summary.fills_failed > 0, "{}", summary.fills_failed);
     // Refined to the size: several times the surface's points.
     assert!(
-        m.points.len() > 2 * s.points.len(),
+        m.points.len() > 2 * surface_points,
         "{} points",
         m.points.len()
     );

@@ -114,6 +114,9 @@ pub struct FrontStats {
     pub cavities_filled: usize,
     /// Tets the constrained Delaunay fill made.
     pub fill_tets: usize,
+    /// Cavities the fill was given and could not close (each then grew,
+    /// went to recovery, or gave way to the region's fill).
+    pub fills_failed: usize,
     /// Regions whose whole surface the fill closed and refined to the
     /// size field (GDT, §2) in place of the front (0 or 1 for one front).
     pub regions_refined: usize,

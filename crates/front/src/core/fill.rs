@@ -107,6 +107,7 @@ impl<'a> Front<'a> {
                         self.apply_fill(faces, fill, n0)
                     }
                     Err(e) => {
+                        self.stats.fills_failed += 1;
                         tracing::debug!(faces = faces.len(), error = %e, "cavity not filled");
                         failed.extend_from_slice(ids);
                     }
@@ -248,6 +249,15 @@ impl<'a> Front<'a> {
 
     /// The live faces in components joined by shared edges, each sorted,
     /// in order of their smallest face id.
+    /// The most faces of one cavity the front leaves (its live faces, by
+    /// edge-connected component).
+    pub(super) fn largest_cavity(&mut self) -> usize {
+        let comps = self.live_components();
+        let n = comps.iter().map(Vec::len).max().unwrap_or(0);
+        tracing::debug!(cavities = comps.len(), largest = n, "front stalled");
+        n
+    }
+
     fn live_components(&mut self) -> Vec<Vec<u32>> {
         let live: Vec<u32> = (0..self.fv.len() as u32)
             .filter(|&f| self.fv[f as usize].alive)
