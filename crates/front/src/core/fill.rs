@@ -247,8 +247,6 @@ impl<'a> Front<'a> {
         true
     }
 
-    /// The live faces in components joined by shared edges, each sorted,
-    /// in order of their smallest face id.
     /// The most faces of one cavity the front leaves (its live faces, by
     /// edge-connected component).
     pub(super) fn largest_cavity(&mut self) -> usize {
@@ -258,6 +256,8 @@ impl<'a> Front<'a> {
         n
     }
 
+    /// The live faces in components joined by shared edges, each sorted,
+    /// in order of their smallest face id.
     fn live_components(&mut self) -> Vec<Vec<u32>> {
         let live: Vec<u32> = (0..self.fv.len() as u32)
             .filter(|&f| self.fv[f as usize].alive)

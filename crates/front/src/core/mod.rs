@@ -94,7 +94,7 @@ const REGION_FILL_SHARE: f64 = 0.5;
 
 /// A first stall with one cavity of this many times the input faces' count
 /// goes to [`Front::fill_region`] at once, without filling its cavities
-/// first: round.stl at size 0.4 stalls on one of 15,784 faces for its
+/// first: round.stl at size 0.4 stalls with one of 15,748 faces for its
 /// 1,120, and the fill spent 4-10 s failing on it before the region's
 /// surface filled in 0.3 s (at size 0.42: one of 9,332). By the cavity,
 /// not the stuck faces: the tray at size 3 stalls on 19,706 faces for its
