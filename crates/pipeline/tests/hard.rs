@@ -153,6 +153,24 @@ fn slot_under_ten_times_its_width() {
 }
 
 #[test]
+fn a_small_surface_whose_cavity_fill_fails_goes_to_the_region_fill() {
+    // The twisted square prism (12 faces) at size 0.1: the front stalls on
+    // about 600 faces and the fill leaves a cavity open. The region's
+    // surface is filled and refined at once; before, the front recovered
+    // until it gave up and the pipeline made that fill (regions_filled).
+    let s = frustum(4, 1.0, 1.0, 1.0, 0.6);
+    let mut o = MeshOptions::default();
+    o.size.h = Some(0.1);
+    let (m, sum) = mesh_surface(&s, &o).expect("the prism at size 0.1 meshes");
+    m.check_against_surface(&s.tris).expect("valid");
+    assert!((m.volume() - s.signed_volume()).abs() <= 1e-9 * s.signed_volume());
+    assert!(sum.fills_failed > 0, "the cavities' fill came first");
+    assert_eq!(sum.regions_refined, vec![1]);
+    assert!(sum.regions_filled.is_empty(), "{:?}", sum.regions_filled);
+    assert_eq!(sum.recovery_rounds, 0);
+}
+
+#[test]
 fn tiny_feature_beside_large_faces() {
     // A boss 1e-4 of the part on a face of 1, at the default size.
     meshes_at("boss 1e-4", &boss_box(1e-4), &[None]);

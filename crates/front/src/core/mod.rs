@@ -89,7 +89,10 @@ const STALL_FILL_SHARE: f64 = 0.25;
 /// the angle block's two open cavities hold 774 faces for its 704, and
 /// cost four recovery rounds and a fill (3.1 s) where its whole surface
 /// fills in 0.14 s; the idler's open cavity, 402 for 1,572, goes on to
-/// recovery (0.9 s), its whole surface's fill failing in 1.4 s.
+/// recovery (0.9 s), its whole surface's fill failing in 1.4 s. So do small
+/// inputs: the twisted square prism (12 faces) at size 0.1 recovered for
+/// 3 s until the front gave up and the pipeline made the same fill (4.6 ->
+/// 1.7 s; at 0.05 16 -> 10 s, at 0.02 160 -> 109 s).
 const REGION_FILL_SHARE: f64 = 0.5;
 
 /// A first stall with one cavity of this many times the input faces' count
@@ -111,7 +114,10 @@ const REGION_FIRST_SHARE: f64 = 6.0;
 const EARLY_FILL_TETS: f64 = 0.5;
 /// Inputs with fewer faces do not: their recovery costs milliseconds, and
 /// the fill's split points cost quality (Schönhardt's prism: 8 tets at
-/// 14.1° became 71 at 6.9°).
+/// 14.1° became 71 at 6.9°). Nor do they go to the region's fill before
+/// their cavities' fill has failed ([`REGION_FIRST_SHARE`]): the boss
+/// (28 faces) stalls with a cavity of 480 that the fill closes, and the
+/// region's fill gave worse tets (1.9 % under 10° for 0.6 %).
 const EARLY_FILL_MIN_FACES: usize = 512;
 
 const NONE: u32 = u32::MAX;
@@ -234,9 +240,10 @@ struct Front<'a> {
     /// where: the one committed keeps its place.
     new_at: Vec<(P3, u32)>,
     relax: u32,
-    /// The input front, kept until the first recovery round: the first
-    /// stall may hand it whole to the fill ([`Front::fill_early`], while
-    /// `early`), or to the fill and the refinement ([`REGION_FILL_SHARE`]).
+    /// The input front, kept until the first recovery round (where the
+    /// front may fill, not in a pass): the first stall may hand it whole to
+    /// the fill ([`Front::fill_early`], while `early`), or to the fill and
+    /// the refinement ([`REGION_FILL_SHARE`], [`REGION_FIRST_SHARE`]).
     input0: Vec<[u32; 3]>,
     /// The front has made too few tets for its input yet
     /// ([`EARLY_FILL_TETS`]).
@@ -403,9 +410,9 @@ impl<'a> Front<'a> {
         for &v in &input.faces {
             f.add_face(v, NONE);
         }
-        if opts.fill && opts.fill_early && !opts.pass && input.faces.len() >= EARLY_FILL_MIN_FACES {
+        if opts.fill && opts.fill_early && !opts.pass {
+            f.early = input.faces.len() >= EARLY_FILL_MIN_FACES;
             f.input0 = input.faces;
-            f.early = true;
         }
         f
     }
@@ -566,6 +573,7 @@ impl<'a> Front<'a> {
                 // One cavity of many times the region's own surface: the
                 // cavities are not tried first.
                 let whole_first = stuck_share >= REGION_FIRST_SHARE
+                    && self.n_input_faces >= EARLY_FILL_MIN_FACES
                     && !self.input0.is_empty()
                     && self.largest_cavity() as f64
                         >= REGION_FIRST_SHARE * self.n_input_faces as f64;
