@@ -14,7 +14,7 @@
 //! with fewer tets under [`SMALL_DIHEDRAL`] and a min dihedral no lower; or, for
 //! a tet under [`LIFT_DEG`], when the cavity's min dihedral rises.
 use crate::ops::{positive, Cand, MARGIN};
-use crate::quality::{min_dihedral_deg, min_dihedral_deg_under, quality};
+use crate::quality::{min_dihedral_deg, positive_min_dihedral_under, quality};
 use crate::work::{ring_tets, Work};
 use parafront_geom::{cross, dist2, norm, sub, P3};
 use parafront_mesh::quality::TET_EDGES;
@@ -183,10 +183,7 @@ impl Work<'_> {
         for &(v, f) in star {
             let mut x = self.pts(v);
             x[f] = pos;
-            if !positive(x) {
-                return None;
-            }
-            let d = min_dihedral_deg_under(x, tan_clamp).unwrap_or(clamp);
+            let d = positive_min_dihedral_under(x, tan_clamp)?.unwrap_or(clamp);
             sc.add_angle(d);
             if bound.is_some_and(|b| cannot_beat(sc.key(old, lift), b)) {
                 return None;

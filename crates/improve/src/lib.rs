@@ -260,6 +260,12 @@ pub(crate) fn run(
     whole: bool,
 ) -> Result<Vec<bool>, TopoError> {
     let mut imp = Improver::new(mesh, frozen)?;
+    schedule(&mut imp, level, st, whole);
+    Ok(imp.w.compact(drop_points))
+}
+
+/// [`run`]'s passes on `imp`.
+fn schedule(imp: &mut Improver, level: u8, st: &mut ImproveStats, whole: bool) {
     let lv = level.min(3);
     // Thresholds on the mean ratio: "bad" for swaps and movement, "very
     // bad" for collapse (§9.2 is a pre-smoothing cleaner). Measured on
@@ -294,7 +300,6 @@ pub(crate) fn run(
             imp.whole_mesh_passes(st);
         }
     }
-    Ok(imp.w.compact(drop_points))
 }
 
 /// The improver's state over a mesh: single operations for tests and
@@ -308,6 +313,11 @@ pub struct Improver<'m> {
     best: Cand,
     batch: batch::Batch,
     points: batch::PointBatch,
+    /// Swaps and collapses that did nothing, at the clock of the try
+    /// (`Improver::idle_at`).
+    idle_memo: rustc_hash::FxHashMap<[u32; 3], u32>,
+    /// Tries the idle memo skipped.
+    idle_skips: usize,
 }
 
 impl<'m> Improver<'m> {
@@ -324,6 +334,8 @@ impl<'m> Improver<'m> {
             best: Cand::default(),
             batch: Default::default(),
             points: Default::default(),
+            idle_memo: Default::default(),
+            idle_skips: 0,
         })
     }
 
@@ -488,5 +500,84 @@ mod tan_tests {
             }
         }
         assert!(checked > 1000, "{checked}");
+    }
+}
+
+#[cfg(test)]
+mod shortcut_tests {
+    use super::*;
+    use parafront_mesh::generate::box_mesh;
+
+    /// A box of 6^3 cells with its inner points moved by up to 0.8 cells
+    /// (each move kept where no tet inverts): slivers and needles.
+    fn shaken_box(seed: u64) -> TetMesh {
+        let n = 6;
+        let mut m = box_mesh(n, n, n, [0.0; 3], [1.0; 3]);
+        let mut r = crate::test_rng(seed);
+        let h = 1.0 / n as f64;
+        for p in 0..m.points.len() {
+            let x = m.points[p];
+            // On the boundary: within its face's plane, away from edges.
+            let on = x.map(|c| c <= 0.0 || c >= 1.0);
+            if on.iter().filter(|&&b| b).count() > 1 {
+                continue;
+            }
+            m.points[p] = [0, 1, 2].map(|i| {
+                if on[i] {
+                    x[i]
+                } else {
+                    x[i] + 1.6 * h * (r() - 0.5)
+                }
+            });
+            if m.points[p].iter().any(|c| !(0.0..=1.0).contains(c)) {
+                m.points[p] = x;
+                continue;
+            }
+            let ok = m.tets.iter().all(|t| {
+                let q = t.map(|v| m.points[v.idx()]);
+                parafront_geom::orient3d(q[0], q[1], q[2], q[3]) > 0.0
+            });
+            if !ok {
+                m.points[p] = x;
+            }
+        }
+        m
+    }
+
+    /// The idle memo and the compass steps cut short change nothing: the
+    /// whole schedule gives the same mesh with them and without, and the
+    /// memo did skip tries.
+    #[test]
+    fn the_shortcuts_give_the_same_mesh() {
+        let mut skipped = 0;
+        for seed in 1..=6u64 {
+            let m0 = shaken_box(0x5ca1_ab1e ^ seed);
+            let mut out = Vec::new();
+            for shortcuts in [true, false] {
+                let mut m = m0.clone();
+                let mut st = ImproveStats::default();
+                // Two points in three frozen, as a CAD part's surface
+                // points are: tets under 10° stay for the passes on them.
+                let frozen: Vec<bool> = (0..m.points.len()).map(|p| p % 3 != 0).collect();
+                let mut imp = Improver::new(&mut m, &frozen).unwrap();
+                imp.w.shortcuts = shortcuts;
+                schedule(&mut imp, 2, &mut st, true);
+                if shortcuts {
+                    skipped += imp.idle_skips;
+                } else {
+                    assert_eq!(imp.idle_skips, 0);
+                }
+                imp.w.compact(true);
+                m.check().unwrap();
+                out.push((
+                    m.points.clone(),
+                    m.tets.clone(),
+                    st.swap.done,
+                    st.selective.done,
+                ));
+            }
+            assert_eq!(out[0], out[1], "seed {seed}");
+        }
+        assert!(skipped > 100, "{skipped}");
     }
 }

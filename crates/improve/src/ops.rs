@@ -7,7 +7,7 @@
 //! beats the worst of those it replaces, and every new tet is positive
 //! under the exact predicate and in floating point.
 use crate::quality::{
-    min_dihedral_deg, min_dihedral_deg_under, positive_quality, quality, quality_over,
+    min_dihedral_deg, positive_min_dihedral_under, positive_quality, quality, quality_over,
 };
 use crate::work::{ring_tets, Work, MAX_RING};
 use parafront_geom::{cross, dist2, norm, sub, P3};
@@ -206,27 +206,28 @@ impl Work<'_> {
         let n = s.ring.len();
         let qold = self.ball_qmin(&s.tets);
         let qbar = bar(qold);
-        const N: usize = MAX_RING;
+        // Tables of stride `n` (at most MAX_RING): only what this ring
+        // uses is reset.
         s.tq.clear();
-        s.tq.resize(N * N * N, f64::NAN);
+        s.tq.resize(n * n * n, f64::NAN);
         s.dp.clear();
-        s.dp.resize(N * N, (f64::INFINITY, 0));
+        s.dp.resize(n * n, (f64::INFINITY, 0));
         let (pa, pb) = (self.m.points[a.idx()], self.m.points[b.idx()]);
-        let r: [P3; N] =
+        let r: [P3; MAX_RING] =
             std::array::from_fn(|i| s.ring.get(i).map_or([0.0; 3], |p| self.m.points[p.idx()]));
         for len in 2..n {
             for i in 0..n - len {
                 let j = i + len;
                 let mut best = (f64::NEG_INFINITY, 0u8);
                 for k in i + 1..j {
-                    let m = s.dp[i * N + k].0.min(s.dp[k * N + j].0);
+                    let m = s.dp[i * n + k].0.min(s.dp[k * n + j].0);
                     // Reject at the first sign of worse (§9.1).
                     if m <= best.0 || !beats(m, qold) {
                         continue;
                     }
-                    let slot = &mut s.tq[(i * N + k) * N + j];
+                    let slot = &mut s.tq[(i * n + k) * n + j];
                     if slot.is_nan() {
-                        // A pair that cannot beat `qold` is scored -inf: no
+                        // A pair that canot beat `qold` is scored -inf: no
                         // choice below reads more of it than that.
                         let q1 = quality_over([r[i], r[k], r[j], pb], qbar);
                         *slot = if beats(q1, qold) {
@@ -240,7 +241,7 @@ impl Work<'_> {
                         best = (v, k as u8);
                     }
                 }
-                s.dp[i * N + j] = best;
+                s.dp[i * n + j] = best;
             }
         }
         let (qnew, _) = s.dp[n - 1];
@@ -252,7 +253,7 @@ impl Work<'_> {
         ring_tets(
             &s.ring,
             (0, n - 1),
-            &|i, j| dp[i * N + j].1 as usize,
+            &|i, j| dp[i * n + j].1 as usize,
             a,
             b,
             &mut c.new,
@@ -592,8 +593,9 @@ impl Work<'_> {
         self.neighbours(p, ball, nb);
         let floor = keep * self.ball_qmin(ball);
         // (min dihedral, tets under 10°) of the ball with p at pos, when no
-        // tet inverts or falls under the mean ratio floor.
-        let eval = |w: &Self, pos: P3| -> Option<(f64, usize)> {
+        // tet inverts or falls under the mean ratio floor, and the min
+        // dihedral stays over `bar` (it only falls as tets are added).
+        let eval = |w: &Self, pos: P3, bar: f64| -> Option<(f64, usize)> {
             let mut d = f64::INFINITY;
             let mut under = 0;
             for &t in ball {
@@ -603,6 +605,9 @@ impl Work<'_> {
                 }
                 let dt = min_dihedral_deg(x);
                 d = d.min(dt);
+                if d <= bar {
+                    return None;
+                }
                 under += usize::from(dt < crate::insert::SMALL_DIHEDRAL);
             }
             Some((d, under))
@@ -613,7 +618,7 @@ impl Work<'_> {
             .map(|x| dist2(self.m.points[x.idx()], p0).sqrt())
             .sum::<f64>()
             / nb.len().max(1) as f64;
-        let (d0, under0) = eval(self, p0)?;
+        let (d0, under0) = eval(self, p0, f64::NEG_INFINITY)?;
         // No more tets under 10° than before: the share under 10° is the
         // issue's other criterion.
         let (best, pos) = compass(
@@ -622,7 +627,16 @@ impl Work<'_> {
             0.1 * len,
             1e-3 * len,
             60,
-            |c, _| eval(self, c).filter(|e| e.1 <= under0).map(|e| e.0),
+            // A step no better than `cur` is not taken: its search stops
+            // at the first tet that shows it.
+            |c, cur| {
+                let bar = if self.shortcuts {
+                    *cur + 1e-9
+                } else {
+                    f64::NEG_INFINITY
+                };
+                eval(self, c, bar).filter(|e| e.1 <= under0).map(|e| e.0)
+            },
             |d, cur| *d > *cur + 1e-9,
         );
         (best > d0 * (1.0 + MARGIN) + 1e-9).then_some(pos)
@@ -641,34 +655,43 @@ impl Work<'_> {
         self.neighbours(p, ball, nb);
         // (tets under 10°, shortfall below 12°, min dihedral) with p at pos;
         // None when a tet inverts, more than `cap` are under 10° or one is
-        // under `floor` (the search's bounds, checked as it goes).
+        // under `floor` (the search's bounds, checked as it goes), or when
+        // `cap` are and the shortfall has reached `short_cap` (it only
+        // grows, so the step cannot be better).
         // `fast`: the search's steps, whose min dihedral is not read.
-        let eval =
-            |w: &Self, pos: P3, cap: usize, floor: f64, fast: bool| -> Option<(usize, f64, f64)> {
-                let (mut under, mut short, mut dmin) = (0, 0.0, f64::INFINITY);
-                for &t in ball {
-                    let x = w.pts_moved(t, p, pos);
-                    // A tet with no angle under 12.5° (the tangent test, no arc
-                    // tangent) adds nothing to the count or the shortfall and
-                    // passes a floor under 12°: only its sign matters.
-                    let d = if fast && floor < 12.0 {
-                        match min_dihedral_deg_under(x, crate::TAN_12_5) {
-                            Some(d) => d,
-                            None if !positive(x) => return None,
-                            None => continue,
-                        }
-                    } else {
-                        min_dihedral_deg(x)
-                    };
-                    under += usize::from(d < crate::insert::SMALL_DIHEDRAL);
-                    if under > cap || d < floor || !positive(x) {
-                        return None;
+        let eval = |w: &Self,
+                    pos: P3,
+                    (cap, short_cap): (usize, f64),
+                    floor: f64,
+                    fast: bool|
+         -> Option<(usize, f64, f64)> {
+            let (mut under, mut short, mut dmin) = (0, 0.0, f64::INFINITY);
+            for &t in ball {
+                let x = w.pts_moved(t, p, pos);
+                // A tet with no angle under 12.5° (the tangent test, no arc
+                // tangent) adds nothing to the count or the shortfall and
+                // passes a floor under 12°: only its sign matters.
+                let (d, known_positive) = if fast && floor < 12.0 {
+                    match positive_min_dihedral_under(x, crate::TAN_12_5) {
+                        Some(Some(d)) => (d, true),
+                        Some(None) => continue,
+                        None => return None,
                     }
-                    short += (12.0 - d).max(0.0);
-                    dmin = dmin.min(d);
+                } else {
+                    (min_dihedral_deg(x), false)
+                };
+                under += usize::from(d < crate::insert::SMALL_DIHEDRAL);
+                if under > cap || d < floor || !(known_positive || positive(x)) {
+                    return None;
                 }
-                Some((under, short, dmin))
-            };
+                short += (12.0 - d).max(0.0);
+                if under == cap && short >= short_cap {
+                    return None;
+                }
+                dmin = dmin.min(d);
+            }
+            Some((under, short, dmin))
+        };
         let better = |a: (usize, f64, f64), b: (usize, f64, f64)| {
             a.0 < b.0 || (a.0 == b.0 && a.1 < b.1 - 1e-9)
         };
@@ -677,14 +700,27 @@ impl Work<'_> {
             .iter()
             .map(|x| dist2(self.m.points[x.idx()], p0).sqrt())
             .fold(f64::INFINITY, f64::min);
-        let e0 = eval(self, p0, usize::MAX, f64::NEG_INFINITY, false)?;
+        let e0 = eval(
+            self,
+            p0,
+            (usize::MAX, f64::INFINITY),
+            f64::NEG_INFINITY,
+            false,
+        )?;
         let (best, pos) = compass(
             p0,
             e0,
             0.3 * len,
             1e-2 * len,
             20,
-            |c, cur| eval(self, c, cur.0, e0.2, true),
+            |c, cur| {
+                let short_cap = if self.shortcuts {
+                    cur.1 - 1e-9
+                } else {
+                    f64::INFINITY
+                };
+                eval(self, c, (cur.0, short_cap), e0.2, true)
+            },
             |a, b| better(*a, *b),
         );
         (best.0 < e0.0).then_some(pos)

@@ -4,6 +4,12 @@
 use super::*;
 use rayon::prelude::*;
 
+/// The third entry of an edge removal's key in [`Improver::idle_at`]'s
+/// memo (no point has this id).
+const EDGE_KEY: u32 = u32::MAX;
+/// The third entry of a collapse's key.
+const COLLAPSE_KEY: u32 = u32::MAX - 1;
+
 impl Improver<'_> {
     /// What follows the last dihedral polish on a whole mesh (parts leave
     /// it to the final polish): the passes for the tets under 10°, the
@@ -331,25 +337,61 @@ impl Improver<'_> {
         let mut kind = None;
         let v = self.w.m.tets[t as usize];
         for e in TET_EDGES {
-            let o = self
-                .w
-                .eval_edge_removal(t, v[e[0]], v[e[1]], &mut self.s, &mut self.c);
-            if o == Outcome::Done && self.c.qmin > best_q {
-                best_q = self.c.qmin;
-                kind = Some(self.c.old.len());
-                std::mem::swap(&mut self.c, &mut self.best);
+            let (a, b) = (v[e[0]], v[e[1]]);
+            let key = [a.raw().min(b.raw()), a.raw().max(b.raw()), EDGE_KEY];
+            if self.idle_at(key) {
+                continue;
+            }
+            let o = self.w.eval_edge_removal(t, a, b, &mut self.s, &mut self.c);
+            if o == Outcome::Done {
+                if self.c.qmin > best_q {
+                    best_q = self.c.qmin;
+                    kind = Some(self.c.old.len());
+                    std::mem::swap(&mut self.c, &mut self.best);
+                }
+            } else {
+                let at = self.w.tick();
+                self.idle_memo.insert(key, at);
             }
         }
         for f in 0..4 {
+            // The face opposite corner `f`.
+            let mut key = [1, 2, 3].map(|k| v[(f + k) % 4].raw());
+            key.sort_unstable();
+            if self.idle_at(key) {
+                continue;
+            }
             let o = self.w.eval_23(t, f, &mut self.c);
-            if o == Outcome::Done && self.c.qmin > best_q {
-                best_q = self.c.qmin;
-                kind = Some(0);
-                std::mem::swap(&mut self.c, &mut self.best);
+            if o == Outcome::Done {
+                if self.c.qmin > best_q {
+                    best_q = self.c.qmin;
+                    kind = Some(0);
+                    std::mem::swap(&mut self.c, &mut self.best);
+                }
+            } else {
+                let at = self.w.tick();
+                self.idle_memo.insert(key, at);
             }
         }
         let k = kind?;
         self.commit().then_some(k)
+    }
+
+    /// The operation keyed `key` did nothing when last tried, and none of
+    /// its points has been touched since: tried again from a neighbouring
+    /// tet (or in a later pass) it would do nothing again. Keys: an edge
+    /// removal's ends (lower first) then [`EDGE_KEY`], a 2-3 swap's face
+    /// corners (sorted), a collapse's two ends (the one that goes first)
+    /// then [`COLLAPSE_KEY`].
+    fn idle_at(&mut self, key: [u32; 3]) -> bool {
+        let idle = self.w.shortcuts
+            && self.idle_memo.get(&key).is_some_and(|&at| {
+                key.iter()
+                    .filter(|&&p| p < COLLAPSE_KEY)
+                    .all(|&p| self.w.touched[p as usize] < at)
+            });
+        self.idle_skips += usize::from(idle);
+        idle
     }
 
     /// §9.2: collapse an edge of each very bad tet, worst first, when the
@@ -369,11 +411,20 @@ impl Improver<'_> {
                     if self.w.frozen[a.idx()] {
                         continue;
                     }
+                    let key = [a.raw(), b.raw(), COLLAPSE_KEY];
+                    if self.idle_at(key) {
+                        continue;
+                    }
                     let o = self.w.eval_collapse(a, b, &mut self.s, &mut self.c);
-                    if o == Outcome::Done && self.c.qmin > best_q {
-                        best_q = self.c.qmin;
-                        gone = Some(a);
-                        std::mem::swap(&mut self.c, &mut self.best);
+                    if o == Outcome::Done {
+                        if self.c.qmin > best_q {
+                            best_q = self.c.qmin;
+                            gone = Some(a);
+                            std::mem::swap(&mut self.c, &mut self.best);
+                        }
+                    } else {
+                        let at = self.w.tick();
+                        self.idle_memo.insert(key, at);
                     }
                 }
             }

@@ -87,6 +87,24 @@ pub fn min_dihedral_deg_under(p: [P3; 4], tan_max: f64) -> Option<f64> {
     dihedral_under(&e, &m, tan_max).then(|| min_dihedral_of(p, e, m))
 }
 
+/// `None` where [`positive_volume6`] refuses the tet, else
+/// [`min_dihedral_deg_under`]`(p, tan_max)`: the searches that need both,
+/// with one set of edges and normals (the volume is the same product,
+/// operation for operation, so every answer is the two calls').
+#[inline]
+pub fn positive_min_dihedral_under(p: [P3; 4], tan_max: f64) -> Option<Option<f64>> {
+    use parafront_geom::{dot, norm2};
+    let (e, m) = edges_and_normals(p);
+    // `positive_volume6`: its `u`, `w`, `z` are `e[0..3]`, and
+    // `cross(u, w)` is `m[3]`.
+    let v6 = dot(m[3], e[2]);
+    let l2 = norm2(e[0]).max(norm2(e[1])).max(norm2(e[2]));
+    if !(v6 > FLAT * l2 * l2.sqrt()) {
+        return None;
+    }
+    Some(dihedral_under(&e, &m, tan_max).then(|| min_dihedral_of(p, e, m)))
+}
+
 /// [`min_dihedral_deg`] from the tet's edges and normals.
 #[inline]
 fn min_dihedral_of(p: [P3; 4], e: [P3; 6], m: [P3; 4]) -> f64 {
@@ -254,6 +272,32 @@ mod tests {
             }
         }
         assert!(under > 10_000, "{under}");
+    }
+
+    /// The fused test gives what the two separate calls give, to the bit,
+    /// flat and inverted tets among them.
+    #[test]
+    fn positive_min_dihedral_under_is_the_two_calls_in_one() {
+        let mut tet = squashed_tets(0x90f1_7e57);
+        let (mut refused, mut under) = (0, 0);
+        for i in 0..100_000 {
+            let mut p = tet(i);
+            if i % 7 == 0 {
+                p.swap(0, 1);
+            }
+            for tan in [crate::TAN_SMALL_DIHEDRAL, crate::TAN_12_5, 1.0] {
+                let two = positive_volume6(p).map(|_| min_dihedral_deg_under(p, tan));
+                let one = positive_min_dihedral_under(p, tan);
+                assert_eq!(
+                    one.map(|d| d.map(f64::to_bits)),
+                    two.map(|d| d.map(f64::to_bits)),
+                    "{p:?}"
+                );
+                refused += usize::from(one.is_none());
+                under += usize::from(one.flatten().is_some());
+            }
+        }
+        assert!(refused > 10_000 && under > 10_000, "{refused} {under}");
     }
 
     #[test]

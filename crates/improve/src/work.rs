@@ -64,6 +64,10 @@ pub(crate) struct Work<'m> {
     pub swap_idle: Vec<u32>,
     pub move_idle: Vec<u32>,
     pub clock: u32,
+    /// The searches' exact shortcuts: the idle memo of the swaps and
+    /// collapses (`Improver::idle_at`) and the compass steps cut short once
+    /// they cannot win. Off only in the test that compares the two.
+    pub shortcuts: bool,
     free: Vec<u32>,
     /// The tets [`Work::ball`] has reached.
     reached: Marks,
@@ -153,6 +157,7 @@ impl<'m> Work<'m> {
             swap_idle: vec![0; nt],
             move_idle: vec![0; np],
             clock: 1,
+            shortcuts: true,
             q,
             free: Vec::new(),
             reached: Marks::default(),
