@@ -25,7 +25,9 @@ impl ProgressLine {
             while !flag.load(Ordering::Relaxed) {
                 bar.set_message(progress_message(&p, t0.elapsed().as_secs_f64()));
                 bar.tick();
-                std::thread::sleep(std::time::Duration::from_millis(100));
+                // Parked, not asleep: `finish` wakes it at once (a sleep
+                // kept every run waiting up to 100 ms at its end).
+                std::thread::park_timeout(std::time::Duration::from_millis(100));
             }
             bar.finish_and_clear();
         });
@@ -38,6 +40,7 @@ impl ProgressLine {
     pub(crate) fn finish(mut self) {
         self.stop.store(true, std::sync::atomic::Ordering::Relaxed);
         if let Some(h) = self.handle.take() {
+            h.thread().unpark();
             let _ = h.join();
         }
     }
