@@ -39,17 +39,24 @@ impl Batch {
         self.tets.clear();
     }
 
-    /// The points of the tets on `t`'s corners into `self.pts`; whether
-    /// none of them is the batch's yet. `t` is alive.
+    /// Whether none of the points of the tets on `t`'s corners is the
+    /// batch's yet; if so, they are in `self.pts` (for [`Batch::take`]).
+    /// Stops at the first that is: most entries a batch passes over meet
+    /// it near their own tet (this test was most of the serial part of the
+    /// insertion pass). `t` is alive.
     pub(crate) fn apart(&mut self, w: &mut Work, t: u32) -> bool {
         self.pts.clear();
         for p in w.m.tets[t as usize] {
             w.ball(p, &mut self.ball);
             for &u in &self.ball {
-                self.pts.extend_from_slice(&w.m.tets[u as usize]);
+                let v = w.m.tets[u as usize];
+                if v.iter().any(|q| self.taken.contains(q.idx())) {
+                    return false;
+                }
+                self.pts.extend_from_slice(&v);
             }
         }
-        !self.pts.iter().any(|p| self.taken.contains(p.idx()))
+        true
     }
 
     /// `t` (checked [`Batch::apart`] just before) joins the batch.
