@@ -420,11 +420,15 @@ impl Work<'_> {
     /// removals of tet `t` that leaves fewer tets under [`SMALL_DIHEDRAL`] and a
     /// min dihedral no lower. Edge removal takes the triangulation of the
     /// ring with the least summed cost (Klincsek's programme on a sum).
+    /// `idle(key)`: an option known to fail (`Improver::idle_at`'s keys),
+    /// skipped; the keys of the options that fail here go to `failed`.
     pub(crate) fn eval_count_swap(
         &self,
         t: u32,
         s: &mut InsScratch,
         c: &mut Cand,
+        idle: impl Fn([u32; 3]) -> bool,
+        failed: &mut Vec<[u32; 3]>,
     ) -> crate::Outcome {
         use crate::Outcome;
         let v = self.m.tets[t as usize];
@@ -432,7 +436,12 @@ impl Work<'_> {
         let mut best: Option<(f64, usize, f64)> = None;
         let mut found = Outcome::NotBetter;
         for f in 0..4 {
+            let key = crate::passes::face_key(v, f);
+            if idle(key) {
+                continue;
+            }
             let Some((nt, new)) = self.face_swap(t, f) else {
+                failed.push(key);
                 continue;
             };
             let old = self.score_old(&[t, nt]);
@@ -451,7 +460,9 @@ impl Work<'_> {
                 }
             }
             let gain = sum - (1000.0 * old.under as f64 + old.short);
-            if ok && under < old.under && dmin >= old.dmin && best.is_none_or(|b| gain < b.0) {
+            if !(ok && under < old.under && dmin >= old.dmin) {
+                failed.push(key);
+            } else if best.is_none_or(|b| gain < b.0) {
                 best = Some((gain, under, dmin));
                 c.set(&[t, nt], new);
                 found = Outcome::Done;
@@ -459,7 +470,12 @@ impl Work<'_> {
         }
         for e in TET_EDGES {
             let (a, b) = (v[e[0]], v[e[1]]);
+            let key = crate::passes::edge_key(a, b);
+            if idle(key) {
+                continue;
+            }
             if self.ring(t, a, b, &mut s.tets, &mut s.ring).is_none() {
+                failed.push(key);
                 continue;
             }
             let old = self.score_old(&s.tets);
@@ -498,11 +514,11 @@ impl Work<'_> {
             }
             let (sum, _, under, dmin) = dp[0][n - 1];
             let gain = sum - (1000.0 * old.under as f64 + old.short);
-            if !sum.is_finite()
-                || under >= old.under
-                || dmin < old.dmin
-                || best.is_some_and(|b| gain >= b.0)
-            {
+            if !sum.is_finite() || under >= old.under || dmin < old.dmin {
+                failed.push(key);
+                continue;
+            }
+            if best.is_some_and(|b| gain >= b.0) {
                 continue;
             }
             best = Some((gain, under, dmin));

@@ -316,6 +316,10 @@ pub struct Improver<'m> {
     /// Swaps and collapses that did nothing, at the clock of the try
     /// (`Improver::idle_at`).
     idle_memo: rustc_hash::FxHashMap<[u32; 3], u32>,
+    /// The same for the count swaps' options (`Work::eval_count_swap`),
+    /// which fail by another test.
+    count_memo: rustc_hash::FxHashMap<[u32; 3], u32>,
+    failed: Vec<[u32; 3]>,
     /// Tries the idle memo skipped.
     idle_skips: usize,
 }
@@ -335,6 +339,8 @@ impl<'m> Improver<'m> {
             batch: Default::default(),
             points: Default::default(),
             idle_memo: Default::default(),
+            count_memo: Default::default(),
+            failed: Vec::new(),
             idle_skips: 0,
         })
     }
@@ -455,7 +461,23 @@ impl<'m> Improver<'m> {
         if t as usize >= self.w.m.tets.len() || !self.w.alive(t) {
             return Outcome::NotFound;
         }
-        let o = self.w.eval_count_swap(t, &mut self.ins, &mut self.best);
+        let mut failed = std::mem::take(&mut self.failed);
+        failed.clear();
+        let (w, memo) = (&self.w, &self.count_memo);
+        let o = w.eval_count_swap(
+            t,
+            &mut self.ins,
+            &mut self.best,
+            |key| passes::idle_in(w, memo, key),
+            &mut failed,
+        );
+        if !failed.is_empty() {
+            let at = self.w.tick();
+            for &key in &failed {
+                self.count_memo.insert(key, at);
+            }
+        }
+        self.failed = failed;
         self.finish_op(o)
     }
 

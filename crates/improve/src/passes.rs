@@ -3,12 +3,29 @@
 //! themselves are in `ops.rs` and `insert.rs`.
 use super::*;
 use rayon::prelude::*;
+use rustc_hash::FxHashMap;
 
 /// The third entry of an edge removal's key in [`Improver::idle_at`]'s
 /// memo (no point has this id).
 const EDGE_KEY: u32 = u32::MAX;
 /// The third entry of a collapse's key.
 const COLLAPSE_KEY: u32 = u32::MAX - 1;
+
+/// An edge removal's key in the idle memos: its ends, lower first, then
+/// [`EDGE_KEY`].
+#[inline]
+pub(crate) fn edge_key(a: PointId, b: PointId) -> [u32; 3] {
+    [a.raw().min(b.raw()), a.raw().max(b.raw()), EDGE_KEY]
+}
+
+/// A 2-3 swap's key in the idle memos: the corners of the face of `v`
+/// opposite corner `f`, sorted.
+#[inline]
+pub(crate) fn face_key(v: [PointId; 4], f: usize) -> [u32; 3] {
+    let mut key = [1, 2, 3].map(|k| v[(f + k) % 4].raw());
+    key.sort_unstable();
+    key
+}
 
 impl Improver<'_> {
     /// What follows the last dihedral polish on a whole mesh (parts leave
@@ -338,7 +355,7 @@ impl Improver<'_> {
         let v = self.w.m.tets[t as usize];
         for e in TET_EDGES {
             let (a, b) = (v[e[0]], v[e[1]]);
-            let key = [a.raw().min(b.raw()), a.raw().max(b.raw()), EDGE_KEY];
+            let key = edge_key(a, b);
             if self.idle_at(key) {
                 continue;
             }
@@ -355,9 +372,7 @@ impl Improver<'_> {
             }
         }
         for f in 0..4 {
-            // The face opposite corner `f`.
-            let mut key = [1, 2, 3].map(|k| v[(f + k) % 4].raw());
-            key.sort_unstable();
+            let key = face_key(v, f);
             if self.idle_at(key) {
                 continue;
             }
@@ -384,12 +399,7 @@ impl Improver<'_> {
     /// corners (sorted), a collapse's two ends (the one that goes first)
     /// then [`COLLAPSE_KEY`].
     fn idle_at(&mut self, key: [u32; 3]) -> bool {
-        let idle = self.w.shortcuts
-            && self.idle_memo.get(&key).is_some_and(|&at| {
-                key.iter()
-                    .filter(|&&p| p < COLLAPSE_KEY)
-                    .all(|&p| self.w.touched[p as usize] < at)
-            });
+        let idle = idle_in(&self.w, &self.idle_memo, key);
         self.idle_skips += usize::from(idle);
         idle
     }
@@ -516,4 +526,15 @@ impl Improver<'_> {
         );
         st.selective.seconds += t0.elapsed().as_secs_f64();
     }
+}
+
+/// Whether `memo` holds `key` from a try at a clock after every change to
+/// its points (and the shortcuts are on).
+pub(crate) fn idle_in(w: &Work, memo: &FxHashMap<[u32; 3], u32>, key: [u32; 3]) -> bool {
+    w.shortcuts
+        && memo.get(&key).is_some_and(|&at| {
+            key.iter()
+                .filter(|&&p| p < COLLAPSE_KEY)
+                .all(|&p| w.touched[p as usize] < at)
+        })
 }
