@@ -392,6 +392,14 @@ impl<'m> Improver<'m> {
             return Outcome::NotFound;
         }
         let o = self.w.eval_collapse(a, b, &mut self.s, &mut self.best);
+        // The search tries the new tets' quality first (most collapses
+        // fail it, and it is cheaper); one collapse asked for names the
+        // link condition first, the rule §9.2 puts first.
+        let o = if o == Outcome::NotBetter && !self.w.link_holds(a, b, &mut self.s) {
+            Outcome::LinkCondition
+        } else {
+            o
+        };
         let o = self.finish_op(o);
         if o == Outcome::Done {
             self.remove_point(a);

@@ -316,13 +316,47 @@ impl Work<'_> {
         if on_edge == 0 {
             return Outcome::NotFound;
         }
+        // The worst new tet first: it is cheaper than the link condition,
+        // and most collapses fail it.
+        let qold = self.ball_qmin(&s.ball);
+        let qbar = bar(qold);
+        c.new.clear();
+        let mut qmin = f64::INFINITY;
+        for &t in &s.ball {
+            let v = self.m.tets[t as usize];
+            if v.contains(&b) {
+                continue;
+            }
+            let nv = v.map(|x| if x == a { b } else { x });
+            qmin = qmin.min(quality_over(self.pts(nv), qbar));
+            if !beats(qmin, qold) {
+                return Outcome::NotBetter;
+            }
+            c.new.push(nv);
+        }
+        if !self.link_holds(a, b, s) {
+            return Outcome::LinkCondition;
+        }
+        if !self.all_positive(&c.new) {
+            return Outcome::Inverted;
+        }
+        c.old.clear();
+        c.old.extend_from_slice(&s.ball);
+        c.qmin = qmin;
+        Outcome::Done
+    }
+
+    /// §9.2's link condition for collapsing `a` into `b`, Lk(a) ∩ Lk(b) =
+    /// Lk(ab), with `s.ball` and `s.ring` as [`Work::eval_collapse`] found
+    /// them (`a`'s ball, and the other corners of the tets on `ab`).
+    pub(crate) fn link_holds(&mut self, a: PointId, b: PointId, s: &mut Scratch) -> bool {
         // Link condition, vertices: a common neighbour must be on the ring.
         self.neighbours(a, &s.ball, &mut s.nb);
         self.ball(b, &mut s.ball2);
         self.neighbours(b, &s.ball2, &mut s.nb2);
         for &x in &s.nb {
             if x != b && s.nb2.contains(&x) && !s.ring.contains(&x) {
-                return Outcome::LinkCondition;
+                return false;
             }
         }
         // Edges: xy in Lk(a) and Lk(b) must be in Lk(ab), i.e. abxy a tet.
@@ -340,33 +374,11 @@ impl Work<'_> {
                     v.contains(&b) && v.contains(&x) && v.contains(&y)
                 });
                 if !in_ab && has(&s.ball, x, y) && has(&s.ball2, x, y) {
-                    return Outcome::LinkCondition;
+                    return false;
                 }
             }
         }
-        let qold = self.ball_qmin(&s.ball);
-        let qbar = bar(qold);
-        c.new.clear();
-        let mut qmin = f64::INFINITY;
-        for &t in &s.ball {
-            let v = self.m.tets[t as usize];
-            if v.contains(&b) {
-                continue;
-            }
-            let nv = v.map(|x| if x == a { b } else { x });
-            qmin = qmin.min(quality_over(self.pts(nv), qbar));
-            if !beats(qmin, qold) {
-                return Outcome::NotBetter;
-            }
-            c.new.push(nv);
-        }
-        if !self.all_positive(&c.new) {
-            return Outcome::Inverted;
-        }
-        c.old.clear();
-        c.old.extend_from_slice(&s.ball);
-        c.qmin = qmin;
-        Outcome::Done
+        true
     }
 
     /// Worst and mean quality of `ball` with `p` at `pos`, stopping at the
