@@ -29,6 +29,7 @@
 
 mod batch;
 mod insert;
+mod memo;
 mod ops;
 pub mod parallel;
 mod passes;
@@ -315,10 +316,10 @@ pub struct Improver<'m> {
     points: batch::PointBatch,
     /// Swaps and collapses that did nothing, at the clock of the try
     /// (`Improver::idle_at`).
-    idle_memo: rustc_hash::FxHashMap<[u32; 3], u32>,
+    idle_memo: memo::IdleMemo,
     /// The same for the count swaps' options (`Work::eval_count_swap`),
     /// which fail by another test.
-    count_memo: rustc_hash::FxHashMap<[u32; 3], u32>,
+    count_memo: memo::IdleMemo,
     failed: Vec<[u32; 3]>,
     /// Tries the idle memo skipped.
     idle_skips: usize,
@@ -330,6 +331,7 @@ impl<'m> Improver<'m> {
         if mesh.neigh.len() != 4 * mesh.tets.len() {
             mesh.build_adjacency()?;
         }
+        let nt = mesh.tets.len();
         Ok(Improver {
             w: Work::new(mesh, frozen),
             s: Scratch::default(),
@@ -338,8 +340,8 @@ impl<'m> Improver<'m> {
             best: Cand::default(),
             batch: Default::default(),
             points: Default::default(),
-            idle_memo: Default::default(),
-            count_memo: Default::default(),
+            idle_memo: memo::IdleMemo::new(nt),
+            count_memo: memo::IdleMemo::new(nt),
             failed: Vec::new(),
             idle_skips: 0,
         })

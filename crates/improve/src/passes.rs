@@ -3,7 +3,6 @@
 //! themselves are in `ops.rs` and `insert.rs`.
 use super::*;
 use rayon::prelude::*;
-use rustc_hash::FxHashMap;
 
 /// The third entry of an edge removal's key in [`Improver::idle_at`]'s
 /// memo (no point has this id).
@@ -530,9 +529,9 @@ impl Improver<'_> {
 
 /// Whether `memo` holds `key` from a try at a clock after every change to
 /// its points (and the shortcuts are on).
-pub(crate) fn idle_in(w: &Work, memo: &FxHashMap<[u32; 3], u32>, key: [u32; 3]) -> bool {
+pub(crate) fn idle_in(w: &Work, memo: &crate::memo::IdleMemo, key: [u32; 3]) -> bool {
     w.shortcuts
-        && memo.get(&key).is_some_and(|&at| {
+        && memo.get(key).is_some_and(|at| {
             key.iter()
                 .filter(|&&p| p < COLLAPSE_KEY)
                 .all(|&p| w.touched[p as usize] < at)
