@@ -320,6 +320,7 @@ pub struct Improver<'m> {
     /// The same for the count swaps' options (`Work::eval_count_swap`),
     /// which fail by another test.
     count_memo: memo::IdleMemo,
+    /// Scratch: the keys of one tet's tries that did nothing.
     failed: Vec<[u32; 3]>,
     /// Tries the idle memo skipped.
     idle_skips: usize,

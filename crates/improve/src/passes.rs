@@ -352,6 +352,8 @@ impl Improver<'_> {
         let mut best_q = f64::NEG_INFINITY;
         let mut kind = None;
         let v = self.w.m.tets[t as usize];
+        let mut failed = std::mem::take(&mut self.failed);
+        failed.clear();
         for e in TET_EDGES {
             let (a, b) = (v[e[0]], v[e[1]]);
             let key = edge_key(a, b);
@@ -359,15 +361,12 @@ impl Improver<'_> {
                 continue;
             }
             let o = self.w.eval_edge_removal(t, a, b, &mut self.s, &mut self.c);
-            if o == Outcome::Done {
-                if self.c.qmin > best_q {
-                    best_q = self.c.qmin;
-                    kind = Some(self.c.old.len());
-                    std::mem::swap(&mut self.c, &mut self.best);
-                }
-            } else {
-                let at = self.w.tick();
-                self.idle_memo.insert(key, at);
+            if o != Outcome::Done {
+                failed.push(key);
+            } else if self.c.qmin > best_q {
+                best_q = self.c.qmin;
+                kind = Some(self.c.old.len());
+                std::mem::swap(&mut self.c, &mut self.best);
             }
         }
         for f in 0..4 {
@@ -376,19 +375,31 @@ impl Improver<'_> {
                 continue;
             }
             let o = self.w.eval_23(t, f, &mut self.c);
-            if o == Outcome::Done {
-                if self.c.qmin > best_q {
-                    best_q = self.c.qmin;
-                    kind = Some(0);
-                    std::mem::swap(&mut self.c, &mut self.best);
-                }
-            } else {
-                let at = self.w.tick();
-                self.idle_memo.insert(key, at);
+            if o != Outcome::Done {
+                failed.push(key);
+            } else if self.c.qmin > best_q {
+                best_q = self.c.qmin;
+                kind = Some(0);
+                std::mem::swap(&mut self.c, &mut self.best);
             }
         }
+        self.note_idle(&failed);
+        self.failed = failed;
         let k = kind?;
         self.commit().then_some(k)
+    }
+
+    /// The tries keyed `keys` did nothing: one tick of the clock for them
+    /// all (nothing changed between them), so that it does not run out on
+    /// large meshes.
+    fn note_idle(&mut self, keys: &[[u32; 3]]) {
+        if keys.is_empty() {
+            return;
+        }
+        let at = self.w.tick();
+        for &key in keys {
+            self.idle_memo.insert(key, at);
+        }
     }
 
     /// The operation keyed `key` did nothing when last tried, and none of
@@ -415,6 +426,8 @@ impl Improver<'_> {
             let v = self.w.m.tets[t as usize];
             let mut best_q = f64::NEG_INFINITY;
             let mut gone = None;
+            let mut failed = std::mem::take(&mut self.failed);
+            failed.clear();
             for e in TET_EDGES {
                 for (a, b) in [(v[e[0]], v[e[1]]), (v[e[1]], v[e[0]])] {
                     if self.w.frozen[a.idx()] {
@@ -425,18 +438,17 @@ impl Improver<'_> {
                         continue;
                     }
                     let o = self.w.eval_collapse(a, b, &mut self.s, &mut self.c);
-                    if o == Outcome::Done {
-                        if self.c.qmin > best_q {
-                            best_q = self.c.qmin;
-                            gone = Some(a);
-                            std::mem::swap(&mut self.c, &mut self.best);
-                        }
-                    } else {
-                        let at = self.w.tick();
-                        self.idle_memo.insert(key, at);
+                    if o != Outcome::Done {
+                        failed.push(key);
+                    } else if self.c.qmin > best_q {
+                        best_q = self.c.qmin;
+                        gone = Some(a);
+                        std::mem::swap(&mut self.c, &mut self.best);
                     }
                 }
             }
+            self.note_idle(&failed);
+            self.failed = failed;
             if let Some(a) = gone {
                 if self.commit() {
                     self.remove_point(a);
