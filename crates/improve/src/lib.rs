@@ -482,12 +482,7 @@ impl<'m> Improver<'m> {
             |key| passes::idle_in(w, memo, key),
             &mut failed,
         );
-        if !failed.is_empty() {
-            let at = self.w.tick();
-            for &key in &failed {
-                self.count_memo.insert(key, at);
-            }
-        }
+        passes::note_idle(&mut self.w, &mut self.count_memo, &failed);
         self.failed = failed;
         self.finish_op(o)
     }

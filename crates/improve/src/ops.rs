@@ -227,7 +227,7 @@ impl Work<'_> {
                     }
                     let slot = &mut s.tq[(i * n + k) * n + j];
                     if slot.is_nan() {
-                        // A pair that canot beat `qold` is scored -inf: no
+                        // A pair that cannot beat `qold` is scored -inf: no
                         // choice below reads more of it than that.
                         let q1 = quality_over([r[i], r[k], r[j], pb], qbar);
                         *slot = if beats(q1, qold) {

@@ -383,23 +383,10 @@ impl Improver<'_> {
                 std::mem::swap(&mut self.c, &mut self.best);
             }
         }
-        self.note_idle(&failed);
+        note_idle(&mut self.w, &mut self.idle_memo, &failed);
         self.failed = failed;
         let k = kind?;
         self.commit().then_some(k)
-    }
-
-    /// The tries keyed `keys` did nothing: one tick of the clock for them
-    /// all (nothing changed between them), so that it does not run out on
-    /// large meshes.
-    fn note_idle(&mut self, keys: &[[u32; 3]]) {
-        if keys.is_empty() {
-            return;
-        }
-        let at = self.w.tick();
-        for &key in keys {
-            self.idle_memo.insert(key, at);
-        }
     }
 
     /// The operation keyed `key` did nothing when last tried, and none of
@@ -447,7 +434,7 @@ impl Improver<'_> {
                     }
                 }
             }
-            self.note_idle(&failed);
+            note_idle(&mut self.w, &mut self.idle_memo, &failed);
             self.failed = failed;
             if let Some(a) = gone {
                 if self.commit() {
@@ -548,4 +535,17 @@ pub(crate) fn idle_in(w: &Work, memo: &crate::memo::IdleMemo, key: [u32; 3]) -> 
                 .filter(|&&p| p < COLLAPSE_KEY)
                 .all(|&p| w.touched[p as usize] < at)
         })
+}
+
+/// The tries keyed `keys` did nothing: into `memo`, with one tick of the
+/// clock for them all (nothing changed between them), so that it does not
+/// run out on large meshes.
+pub(crate) fn note_idle(w: &mut Work, memo: &mut crate::memo::IdleMemo, keys: &[[u32; 3]]) {
+    if keys.is_empty() {
+        return;
+    }
+    let at = w.tick();
+    for &key in keys {
+        memo.insert(key, at);
+    }
 }
