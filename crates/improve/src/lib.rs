@@ -30,6 +30,7 @@
 mod batch;
 mod insert;
 mod memo;
+mod moves;
 mod ops;
 pub mod parallel;
 mod passes;

@@ -53,6 +53,32 @@ pub fn quality_over(p: [P3; 4], bar: f64) -> f64 {
     mean_ratio_of(v6, l2)
 }
 
+/// Whether a positive tet of `6V` = `v6` and squared edges `l2` has a
+/// mean ratio (as `mean_ratio_of` rounds it) under `floor`: decided from
+/// `(3V)^2` against `(floor l2 / 12)^3` where they differ by more than a
+/// relative 1e-9, far above the rounding of either side (as
+/// [`quality_over`]); the cube root only in between.
+#[inline(always)]
+pub(crate) fn mean_ratio_under(v6: f64, l2: f64, floor: f64) -> bool {
+    if !(floor > 0.0) {
+        return false; // a positive tet's quality is positive
+    }
+    let v3 = 0.5 * v6;
+    let a = v3 * v3;
+    let t = floor * l2 / 12.0;
+    let b = t * t * t;
+    if !(a.is_normal() && b.is_normal()) {
+        // Overflow or underflow: no margin holds there.
+        mean_ratio_of(v6, l2) < floor
+    } else if a < b * (1.0 - 1e-9) {
+        true
+    } else if a > b * (1.0 + 1e-9) {
+        false
+    } else {
+        mean_ratio_of(v6, l2) < floor
+    }
+}
+
 /// The mean ratio of a tet that is positive both in floating point and
 /// exactly, else `None`: [`quality`] with the one determinant.
 #[inline]
@@ -220,6 +246,44 @@ fn dihedral_under(e: &[P3; 6], m: &[P3; 4], tan_max: f64) -> bool {
 
 #[cfg(test)]
 mod tests {
+    /// The cube-root-free test answers as the mean ratio it stands for:
+    /// floors just under, at and just over each tet's quality (a relative
+    /// 1e-12 to 1e-6 away, inside and outside its margin), tets from
+    /// regular to flat, at scales from 1e-30 to 1e30.
+    #[test]
+    fn mean_ratio_under_is_the_mean_ratio_against_the_floor() {
+        use parafront_mesh::quality::{edge_length2_sum, mean_ratio_of};
+        let mut u = crate::test_rng(0x9e37_79b9_7f4a_7c15u64);
+        let (mut under, mut over) = (0, 0);
+        for k in 0..100_000 {
+            let scale = 10f64.powi((k % 61) as i32 - 30);
+            let mut p = [[0.0; 3]; 4];
+            for q in &mut p {
+                *q = [u() - 0.5, u() - 0.5, u() - 0.5].map(|x| x * scale);
+            }
+            if k % 3 == 0 {
+                p[3] = [
+                    0.5 * (p[0][0] + p[1][0]),
+                    0.5 * (p[0][1] + p[1][1]),
+                    p[3][2] * 1e-4,
+                ];
+            }
+            let Some(v6) = positive_volume6(p) else {
+                continue;
+            };
+            let l2 = edge_length2_sum(p);
+            let q = mean_ratio_of(v6, l2);
+            let rel = [0.0, 1e-12, -1e-12, 1e-10, -1e-10, 1e-9, -1e-9, 1e-6, -1e-6][k % 9];
+            for floor in [q * (1.0 + rel), q, f64::INFINITY, 0.0, -1.0, f64::NAN] {
+                let want = q < floor;
+                assert_eq!(mean_ratio_under(v6, l2, floor), want, "{p:?} {floor}");
+                under += usize::from(want);
+                over += usize::from(!want);
+            }
+        }
+        assert!(under > 50_000 && over > 200_000, "{under} {over}");
+    }
+
     use super::*;
 
     /// Random tets, the `i`-th regular-ish, flattened, stretched or flat
