@@ -446,14 +446,34 @@ impl<'a> Locator<'a> {
         }
     }
 
+    /// [`Locator::lowest_host`] of each of the DDG's input points (its
+    /// vertices on the region's boundary, by id), or `u32::MAX` for one on
+    /// no tet: the lowest part among the tets on it. A vertex of a
+    /// conforming mesh lies on no other tet, so this is the bins' answer;
+    /// those points are on the DDG's boundary, never strictly inside a
+    /// tet, and the bins were most of the redistribution's time.
+    pub fn lowest_at_inputs(&self, part: &[u32]) -> Vec<u32> {
+        let mut low = vec![u32::MAX; self.d.n_input];
+        for (tv, &k) in self.d.tets.iter().zip(part) {
+            for &v in tv {
+                if let Some(l) = low.get_mut(v as usize) {
+                    *l = (*l).min(k);
+                }
+            }
+        }
+        low
+    }
+
     /// The lowest part among the DDG tets touching `p` (§8), or `None`
     /// outside the DDG. `hint` is a tet near `p` (or `u32::MAX`), updated
-    /// to the tet found holding `p` strictly: the answer does not depend
-    /// on it.
+    /// to the tet found holding `p` strictly (else `u32::MAX`): the answer
+    /// does not depend on it. A walk from it goes first.
     pub fn lowest_host(&self, p: P3, part: &[u32], hint: &mut u32) -> Option<u32> {
-        if self.holds_alone(*hint, p) {
-            return Some(part[*hint as usize]);
+        if let Some(t) = self.walk(*hint, p, WALK_STEPS) {
+            *hint = t;
+            return Some(part[t as usize]);
         }
+        *hint = u32::MAX;
         let mut lo: Option<u32> = None;
         if let Some(t) = self.scan(p, |t| {
             let k = part[t as usize];
@@ -634,6 +654,30 @@ mod tests {
             out.swap(i, (rnd() * (i + 1) as f64) as usize % (i + 1));
         }
         out
+    }
+
+    /// The lowest part on each input vertex, from the tets, is the one
+    /// the bins give (a vertex is on no tet it is not a corner of).
+    #[test]
+    fn lowest_at_inputs_is_lowest_host() {
+        let d = torus_ddg();
+        let loc = Locator::new(&d);
+        let part: Vec<u32> = (0..d.tets.len() as u32).map(|t| (t / 7) % 5).collect();
+        let low = loc.lowest_at_inputs(&part);
+        assert_eq!(low.len(), d.n_input);
+        let mut mixed = 0;
+        for (v, &l) in low.iter().enumerate() {
+            let want = brute(&d, d.points[v]);
+            assert!(!want.is_empty(), "input point {v} is on a tet");
+            let parts: Vec<u32> = want.iter().map(|&t| part[t as usize]).collect();
+            assert_eq!(Some(l), parts.iter().min().copied(), "vertex {v}");
+            assert_eq!(
+                Some(l),
+                loc.lowest_host(d.points[v], &part, &mut u32::MAX.clone())
+            );
+            mixed += usize::from(parts.iter().any(|&k| k != l));
+        }
+        assert!(mixed > 10, "vertices between parts: {mixed}");
     }
 
     #[test]

@@ -199,29 +199,58 @@ fn send_tets(
     loc: &Locator,
     part0: &[u32],
 ) -> Vec<Vec<(u32, Batch)>> {
+    let at_inputs = loc.lowest_at_inputs(part0);
     parts
         .into_par_iter()
         .enumerate()
         .map(|(i, part)| {
             let k = start + i;
+            // Each point's lowest part, and the DDG tet that holds it
+            // strictly where one does: a walk for a tet's next corner
+            // starts there (the points' own order jumps about).
             let mut host: Vec<Option<u32>> = vec![None; part.pts.len()];
-            let mut hint = u32::MAX;
+            let mut place = vec![u32::MAX; part.pts.len()];
             let dst: Vec<u32> = part
                 .tets
                 .iter()
                 .map(|tv| {
+                    let mut hint = tv
+                        .iter()
+                        .map(|&i| place[i as usize])
+                        .find(|&t| t != u32::MAX)
+                        .unwrap_or(u32::MAX);
                     tv.iter()
                         .map(|&i| {
-                            *host[i as usize].get_or_insert_with(|| {
-                                loc.lowest_host(part.pts[i as usize], part0, &mut hint)
-                                    .unwrap_or(k as u32)
-                            })
+                            let i = i as usize;
+                            if let Some(low) = host[i] {
+                                return low;
+                            }
+                            let p = part.pts[i];
+                            let low = match at_inputs.get(part.gid[i] as usize) {
+                                Some(&low) if low != u32::MAX => {
+                                    debug_assert_eq!(
+                                        Some(low),
+                                        loc.lowest_host(p, part0, &mut u32::MAX.clone())
+                                    );
+                                    low
+                                }
+                                _ => {
+                                    let mut at = hint;
+                                    let low = loc.lowest_host(p, part0, &mut at);
+                                    if at != u32::MAX {
+                                        (place[i], hint) = (at, at);
+                                    }
+                                    low.unwrap_or(k as u32)
+                                }
+                            };
+                            host[i] = Some(low);
+                            low
                         })
                         .min()
                         .unwrap()
                 })
                 .collect();
-            drop(host);
+            drop((host, place));
             batches(&part.pts, &part.gid, &part.tets, &part.tet_pass, &dst)
         })
         .collect()
