@@ -1,6 +1,7 @@
 //! The improvement's passes over the whole mesh (§9): which tets each
 //! operation is tried on, in which order, and how often; the operations
-//! themselves are in `ops.rs` and `insert.rs`.
+//! themselves are in `ops.rs` (swaps, collapse), `moves.rs` (point moves)
+//! and `insert.rs`.
 use super::*;
 use rayon::prelude::*;
 
