@@ -28,7 +28,8 @@ impl Work<'_> {
     }
 
     /// [`Work::ball_quality_above`], giving each tet's quality to `keep`
-    /// as it goes (all of them when the answer is `Ok`).
+    /// in the ball's order: all of them when the answer is `Ok`, the only
+    /// case a caller reads them.
     ///
     /// First the verdict, tet by tet in the ball's order as before, with no
     /// cube root where a tet is certainly under the floor or certainly
