@@ -210,23 +210,17 @@ impl Work<'_> {
             (lap, 0.25),
         ] {
             let pos = [0, 1, 2].map(|k| p0[k] + w * (c[k] - p0[k]));
-            let mut q = std::mem::take(&mut s.moved_q);
+            let q = &mut s.moved_q;
             q.clear();
-            let found = self.ball_quality_into(p, pos, ball, qmin, |x| q.push(x));
-            let done = match found {
-                BallQ::Inverted => {
-                    inverted = true;
-                    false
+            match self.ball_quality_into(p, pos, ball, qmin, |x| q.push(x)) {
+                BallQ::Inverted => inverted = true,
+                BallQ::Below => {}
+                BallQ::Ok(m, mean) => {
+                    if beats(m, qmin) || (m >= qmin && mean > qmean + 1e-9) {
+                        self.commit_move_scored(p, pos, ball, &s.moved_q);
+                        return Outcome::Done;
+                    }
                 }
-                BallQ::Below => false,
-                BallQ::Ok(m, mean) => beats(m, qmin) || (m >= qmin && mean > qmean + 1e-9),
-            };
-            if done {
-                self.commit_move_scored(p, pos, ball, &q);
-            }
-            s.moved_q = q;
-            if done {
-                return Outcome::Done;
             }
         }
         if inverted {
