@@ -18,6 +18,7 @@
 #![warn(missing_docs)]
 
 mod adjacency;
+mod angles;
 mod check;
 pub mod compact;
 mod faces;

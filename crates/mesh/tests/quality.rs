@@ -223,3 +223,48 @@ fn edge_ratios_of_a_large_box_count_each_edge_once() {
         / e.count as f64;
     assert!((e.mean - mean).abs() < 1e-9, "{} {mean}", e.mean);
 }
+
+/// The report's histograms, extremes and count of small angles are those
+/// of `tet_quality` and `dihedral_angles` tet by tet (the report takes
+/// most angles from a polynomial, and `atan2` only where it decides).
+#[test]
+fn report_matches_the_measures_tet_by_tet() {
+    let mut m = box_mesh(12, 9, 7, [0.0, 0.0, 0.0], [1.0, 0.7, 0.3]);
+    // Shaken points: angles all over the range, some close to flat.
+    let mut s = 0x9e37_79b9_7f4a_7c15u64;
+    let mut r = move || {
+        s ^= s << 13;
+        s ^= s >> 7;
+        s ^= s << 17;
+        (s >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+    };
+    for p in &mut m.points {
+        for v in p.iter_mut() {
+            *v += 0.04 * r();
+        }
+    }
+    let rep = QualityReport::new(&m);
+    let mut dih = Histogram::new(0.0, 180.0, 180);
+    let mut lo = Histogram::new(0.0, 180.0, 180);
+    let mut hi = Histogram::new(0.0, 180.0, 180);
+    let (mut min, mut max, mut small) = (f64::INFINITY, f64::NEG_INFINITY, 0);
+    for t in &m.tets {
+        let p = t.map(|v| m.points[v.idx()]);
+        let q = tet_quality(p);
+        for a in dihedral_angles(p) {
+            dih.add(a);
+        }
+        lo.add(q.min_dihedral);
+        hi.add(q.max_dihedral);
+        min = min.min(q.min_dihedral);
+        max = max.max(q.max_dihedral);
+        small += usize::from(q.min_dihedral < SMALL_DIHEDRAL);
+    }
+    assert!(small > 0 && min < 5.0 && max > 150.0, "{small} {min} {max}");
+    assert_eq!(rep.dihedral_hist.counts, dih.counts);
+    assert_eq!(rep.min_dihedral_hist.counts, lo.counts);
+    assert_eq!(rep.max_dihedral_hist.counts, hi.counts);
+    assert_eq!((rep.min_dihedral.min, rep.max_dihedral.max), (min, max));
+    let share = small as f64 / m.tets.len() as f64;
+    assert_eq!(rep.share_min_dihedral_below, share);
+}

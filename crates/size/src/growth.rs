@@ -343,6 +343,20 @@ impl SurfaceGrowth {
     /// roundings of `dist` and `point_box_d2` (the lists do not depend on
     /// the fusing).
     fn child_lists(&self, list: &[u32], lo: P3, h: f64, eps: f64) -> [Vec<u32>; 8] {
+        self.child_lists_and::<false>(list, lo, h, eps).0
+    }
+
+    /// [`child_lists`](Self::child_lists), and with `UNION` their union:
+    /// the seeds of `list` in any child's list, in `list`'s order (the
+    /// near cells' test wants it, and a sort of the eight lists joined
+    /// was a tenth of the build).
+    fn child_lists_and<const UNION: bool>(
+        &self,
+        list: &[u32],
+        lo: P3,
+        h: f64,
+        eps: f64,
+    ) -> ([Vec<u32>; 8], Vec<u32>) {
         let c = self.c;
         // The halves' bounds and centres per axis: [lower, upper].
         let los = [0, 1, 2].map(|k| [lo[k], lo[k] + h]);
@@ -371,7 +385,10 @@ impl SurfaceGrowth {
         }
         // f is c-Lipschitz: f <= f(centre) + c * half-diagonal on a child.
         let u = fc.map(|f| ((f + c * h * 0.5 * 3f64.sqrt()) * (1.0 + 1e-12)).min(self.cap));
-        let mut out: [Vec<u32>; 8] = Default::default();
+        // Which children keep each seed, as a mask, then lists of their
+        // exact size: pushes that grew eight lists were a tenth of the build.
+        let mut masks: Vec<u8> = Vec::with_capacity(list.len());
+        let mut count = [0usize; 8];
         for &j in list {
             let sd = &self.seeds[j as usize];
             let sq = [0, 1, 2].map(|k| {
@@ -379,20 +396,38 @@ impl SurfaceGrowth {
                 let (a, b) = (e(0), e(1));
                 [a * a, b * b]
             });
-            for (ch, out) in out.iter_mut().enumerate() {
+            let mut m = 0u8;
+            for ch in 0..8 {
                 let d2 = 0.0 + sq[0][bit(ch, 0)] + sq[1][bit(ch, 1)] + sq[2][bit(ch, 2)];
-                if (sd.h + c * d2.sqrt()) * (1.0 + eps) <= u[ch] {
+                let keep = (sd.h + c * d2.sqrt()) * (1.0 + eps) <= u[ch];
+                m |= (keep as u8) << ch;
+                count[ch] += keep as usize;
+            }
+            masks.push(m);
+        }
+        // One more for the bounding seed below.
+        let mut out: [Vec<u32>; 8] = count.map(|n| Vec::with_capacity(n + 1));
+        let mut union = Vec::new();
+        for (&j, &m) in list.iter().zip(&masks) {
+            for (ch, out) in out.iter_mut().enumerate() {
+                if m >> ch & 1 == 1 {
                     out.push(j);
                 }
+            }
+            if UNION && m != 0 {
+                union.push(j);
             }
         }
         // With eps > 0 the seed that bounds f on a child must stay.
         for (ch, out) in out.iter_mut().enumerate() {
             if best[ch] != u32::MAX && !out.contains(&best[ch]) {
                 out.push(best[ch]);
+                if UNION && !union.contains(&best[ch]) {
+                    union.push(best[ch]);
+                }
             }
         }
-        out
+        (out, union)
     }
 
     /// The octree in two phases: breadth first to a frontier of about
@@ -544,10 +579,13 @@ impl SurfaceGrowth {
             if p.list.len() <= 8 * NEAR_MAX || force {
                 // Tighter: union of the sets of the 2x2x2 sub-cells, which
                 // are also the children's lists if the cell splits.
-                let lists = self.child_lists(&p.list, lo, s / 2.0, 0.0);
-                let mut list = lists.concat();
-                list.sort_unstable();
-                list.dedup();
+                let (lists, mut list) = self.child_lists_and::<true>(&p.list, lo, s / 2.0, 0.0);
+                // Ascending and distinct, as the lists joined, sorted and
+                // deduplicated were: the union is in the parent's order, but
+                // for a bounding seed kept last.
+                if !list.is_sorted() {
+                    list.sort_unstable();
+                }
                 if list.len() <= NEAR_MAX {
                     return Decision::Near(list);
                 }
@@ -757,6 +795,20 @@ mod tests {
                     assert_eq!(list, &one, "child {ch} of {lo:?} size {s}");
                     kept += list.len();
                 }
+                // The union, sorted: the lists joined, sorted and
+                // deduplicated (a bounding seed the cap would drop comes
+                // last, out of the parent's order).
+                let (lists, mut union) = g.child_lists_and::<true>(&all, lo, s / 2.0, eps);
+                assert_eq!(lists, fused);
+                let mut want = lists.concat();
+                want.sort_unstable();
+                want.dedup();
+                union.sort_unstable();
+                assert_eq!(union, want);
+                let rev: Vec<u32> = all.iter().rev().copied().collect();
+                let (_, mut union) = g.child_lists_and::<true>(&rev, lo, s / 2.0, eps);
+                union.sort_unstable();
+                assert_eq!(union, want);
             }
             let pts: [P3; 15] = std::array::from_fn(|i| {
                 if i < 8 {
