@@ -99,9 +99,21 @@ pub(crate) fn for_each_key_slice(
                 n
             },
         );
-        keys.par_sort_unstable();
+        sort_unstable(&mut keys);
         keys.truncate(keys.partition_point(|&x| x != u128::MAX));
         f(&keys, r.clone());
+    }
+}
+
+/// `sort_unstable`, in parallel when the pool has threads to spare:
+/// rayon's sort on one thread took a third longer than the standard
+/// library's (a face table's slice: 8.6 ms against 6.5). Either gives the
+/// one sorted order.
+pub(crate) fn sort_unstable<T: Ord + Send>(v: &mut [T]) {
+    if rayon::current_num_threads() > 1 {
+        v.par_sort_unstable();
+    } else {
+        v.sort_unstable();
     }
 }
 

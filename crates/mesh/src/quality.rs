@@ -157,7 +157,7 @@ pub fn for_each_edge_size_ratio(
             }
             n
         });
-        edges.par_sort_unstable();
+        crate::faces::sort_unstable(&mut edges);
         edges.truncate(edges.partition_point(|&e| e != u64::MAX));
         edges.dedup();
         ratios.clear();
