@@ -643,14 +643,22 @@ fn write_pieces<C: Comm>(
         Ok(files) => files,
     };
     sum.push(Stage::Write, t0.elapsed().as_secs_f64());
-    let peaks = comm.all_gather(vec![peak_memory_bytes().unwrap_or(0); n]);
+    // One value per process: its first part carries it, the others a
+    // mark. (Told apart by value, two processes with the same peak were
+    // one, and the line went missing.)
+    let peak = peak_memory_bytes().unwrap_or(0).min(u64::MAX - 1);
+    let mine: Vec<u64> = (0..n)
+        .map(|i| if i == 0 { peak } else { u64::MAX })
+        .collect();
+    let per: Vec<u64> = comm
+        .all_gather(mine)
+        .into_iter()
+        .filter(|&p| p != u64::MAX)
+        .collect();
     if lead {
         print_summary(sum);
         parallel::print_parallel(sum);
-        if peaks.len() > 1 && peaks.iter().any(|&p| p != peaks[0]) {
-            // One value per part: a process's repeats for each part it holds.
-            let mut per: Vec<u64> = peaks.clone();
-            per.dedup();
+        if per.len() > 1 {
             println!(
                 "peak memory per process: {} MiB",
                 per.iter()
