@@ -95,14 +95,22 @@ pub fn edge_length2_sum(p: [P3; 4]) -> f64 {
 
 /// Dihedral angles, radius ratio, mean ratio and volume of the tet `p`.
 pub fn tet_quality(p: [P3; 4]) -> TetQuality {
-    let d = dihedral_angles(p);
+    let (min_dihedral, max_dihedral) = extremes(&dihedral_angles(p));
     TetQuality {
-        min_dihedral: d.iter().copied().fold(f64::INFINITY, f64::min),
-        max_dihedral: d.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+        min_dihedral,
+        max_dihedral,
         radius_ratio: radius_ratio(p),
         mean_ratio: mean_ratio(p),
         volume: tet_volume6(p[0], p[1], p[2], p[3]) / 6.0,
     }
+}
+
+/// The smallest and the largest of a tet's dihedral angles (NaNs left
+/// out, as `f64::min` and `max` leave them).
+fn extremes(d: &[f64; 6]) -> (f64, f64) {
+    let min = d.iter().copied().fold(f64::INFINITY, f64::min);
+    let max = d.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    (min, max)
 }
 
 /// Quality of every tet; `None` for a tet with a point id out of range.
@@ -467,8 +475,7 @@ impl QualityReport {
                     let (bins, min_dihedral, max_dihedral) = crate::angles::report_angles(p)
                         .unwrap_or_else(|| {
                             let d = dihedral_angles(p);
-                            let min = d.iter().copied().fold(f64::INFINITY, f64::min);
-                            let max = d.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+                            let (min, max) = extremes(&d);
                             (d, min, max)
                         });
                     let q = TetQuality {
