@@ -239,7 +239,7 @@ const LIFT_ROUNDS: usize = 2;
 /// Tets under this min dihedral (degrees) may be lifted, last: the
 /// issue's floor of 20° (at 18°, sphere_1e6 at `--parts 4` kept a tet of
 /// 18.57° where the passes met).
-const LIFT_SWAP_DEG: f64 = 20.0;
+pub const LIFT_SWAP_DEG: f64 = 20.0;
 /// Its tangent.
 const TAN_LIFT: f64 = 0.363_970_234_266_202_34;
 /// The worst tets (at most) that get a swap or a point to lift them.

@@ -146,8 +146,8 @@ pub(crate) fn run<C: Comm>(
 /// and their shared lists found again. Global point ids stay.
 pub fn shift_pieces<C: Comm>(comm: &C, pieces: Vec<Piece>) -> Result<Vec<Piece>, PassError> {
     let start = comm.owned().start;
-    let out: Vec<Vec<(u32, Batch)>> = pieces
-        .into_par_iter()
+    let dst = pieces
+        .par_iter()
         .enumerate()
         .map(|(i, pc)| {
             let k = (start + i) as u32;
@@ -157,13 +157,27 @@ pub fn shift_pieces<C: Comm>(comm: &C, pieces: Vec<Piece>) -> Result<Vec<Piece>,
                     low[j as usize] = low[j as usize].min(q);
                 }
             }
-            let dst: Vec<u32> = pc
-                .tets
+            pc.tets
                 .iter()
                 .map(|t| t.iter().map(|&j| low[j as usize]).min().unwrap_or(k))
-                .collect();
-            batches(&pc.points, &pc.gid, &pc.tets, &pc.tet_pass, &dst)
+                .collect()
         })
+        .collect();
+    move_pieces(comm, pieces, dst)
+}
+
+/// Every tet of the pieces this process holds goes to the part `dst`
+/// gives it (per piece, per tet); the pieces are rebuilt as in
+/// [`shift_pieces`]. Global point ids stay.
+pub fn move_pieces<C: Comm>(
+    comm: &C,
+    pieces: Vec<Piece>,
+    dst: Vec<Vec<u32>>,
+) -> Result<Vec<Piece>, PassError> {
+    let out: Vec<Vec<(u32, Batch)>> = pieces
+        .into_par_iter()
+        .zip(dst)
+        .map(|(pc, dst)| batches(&pc.points, &pc.gid, &pc.tets, &pc.tet_pass, &dst))
         .collect();
     let inbox = comm.exchange(out);
     let mut pieces = agreed(comm, receive_tets(inbox))?;
