@@ -391,6 +391,9 @@ impl Work<'_> {
 
     /// Appends a free point at `pos` (for an insertion about to commit).
     pub(crate) fn push_point(&mut self, pos: P3) -> PointId {
+        if self.m.points.len() == self.m.points.capacity() {
+            self.grow_points();
+        }
         self.m.points.push(pos);
         self.frozen.push(false);
         self.dead_pt.push(false);

@@ -212,6 +212,13 @@ fn fill_pocket(
 pub(super) fn absorb(part: &mut Part, m: Made, base: u32, pass: u8) -> usize {
     let Some(r) = m.res else { return 0 };
     let n_in = m.input_gid.len();
+    // Room made once: grown by doubling, the part's arrays were copied
+    // while the pass's other results waited (a rank's peak under MPI).
+    let n_new = r.points.len().saturating_sub(n_in);
+    part.pts.reserve_exact(n_new);
+    part.size.reserve_exact(n_new);
+    part.gid.reserve_exact(n_new);
+    part.index.reserve(n_new);
     let map: Vec<u32> = (0..r.points.len())
         .map(|i| {
             let gid = if i < n_in {
@@ -236,11 +243,18 @@ pub(super) fn absorb(part: &mut Part, m: Made, base: u32, pass: u8) -> usize {
             }
         }
     }
-    for t in &r.tets {
-        part.tets.push(t.map(|i| map[i as usize]));
-        part.tet_pass.push(pass);
+    let n = r.tets.len();
+    let mapped = r.tets.into_iter().map(|t| t.map(|i| map[i as usize]));
+    if part.tets.is_empty() {
+        // In place: no second copy of the part's tets.
+        part.tets = mapped.collect();
+    } else {
+        part.tets.reserve_exact(n);
+        part.tets.extend(mapped);
     }
-    r.tets.len()
+    part.tet_pass.reserve_exact(n);
+    part.tet_pass.resize(part.tet_pass.len() + n, pass);
+    n
 }
 
 /// Whether face `f` of a pass's result got stuck: the region rules of §7

@@ -152,7 +152,7 @@ fn improve_round<C: Comm>(
     let n_regions = region.len();
     // One piece per task: pieces differ in cost; the stats add in order.
     let done: Vec<(Improved, Option<ImproveStats>)> = pieces
-        .par_iter()
+        .par_iter_mut()
         .enumerate()
         .with_max_len(1)
         .map(|(i, pc)| improve_piece(pc, region[i / held.max(1)], n_input, io, near))
@@ -241,7 +241,7 @@ fn improve_round<C: Comm>(
 ///
 /// [`SHIFT_LAYERS`]: parafront_improve::parallel::SHIFT_LAYERS
 fn improve_piece(
-    pc: &Piece,
+    pc: &mut Piece,
     region: u32,
     n_input: usize,
     io: &ImproveOptions,
@@ -260,13 +260,23 @@ fn improve_piece(
         .filter(|&j| on_boundary[j])
         .map(|j| (key(pc.points[j]), j as u32))
         .collect();
-    let whole = || TetMesh {
-        points: pc.points.clone(),
-        tets: pc.tets.iter().map(|t| t.map(PointId::from_raw)).collect(),
+    let free = near.map(|ids| {
+        let from =
+            (0..pc.points.len() as u32).filter(|&j| ids.binary_search(&pc.gid[j as usize]).is_ok());
+        near_points(pc, from, parafront_improve::parallel::SHIFT_LAYERS)
+    });
+    // The piece's points and tets move into the mesh (a copy would be a
+    // second piece at the rank's peak); the round puts them back.
+    let mut whole = || TetMesh {
         region: vec![region; pc.tets.len()],
+        points: std::mem::take(&mut pc.points),
+        tets: std::mem::take(&mut pc.tets)
+            .into_iter()
+            .map(|t| t.map(PointId::from_raw))
+            .collect(),
         ..Default::default()
     };
-    let (mesh, st) = match near {
+    let (mesh, st) = match free {
         None => {
             // Faces in one tet of the piece (its boundary and its cuts) are
             // frozen by the improver itself.
@@ -275,17 +285,13 @@ fn improve_piece(
                 .map_err(|source| MeshError::Improve { source })?;
             (mesh, Some(st))
         }
-        Some(ids) => {
-            let from = (0..pc.points.len() as u32)
-                .filter(|&j| ids.binary_search(&pc.gid[j as usize]).is_ok());
-            let free = near_points(pc, from, parafront_improve::parallel::SHIFT_LAYERS);
-            if free.contains(&true) {
-                let (mesh, st) = improve_balls(pc, region, &free, io)?;
-                (mesh, Some(st))
-            } else {
-                (whole(), None)
-            }
+        Some(free) if free.contains(&true) => {
+            let (mesh, st) = improve_balls(pc, region, &free, io)?;
+            pc.points = Vec::new();
+            pc.tets = Vec::new();
+            (mesh, Some(st))
         }
+        Some(_) => (whole(), None),
     };
     let was = mesh
         .points
@@ -370,7 +376,8 @@ fn improve_balls(
 /// the shared lists carried over (shared points are boundary points).
 fn renumber(pc: &mut Piece, d: &Improved, kept: &[u32], own_base: u32, tet_base: u32, k: u32) {
     let mut own = own_base;
-    let mut now_of = vec![u32::MAX; pc.points.len()];
+    // The piece's points are in `d` now; its ids still number them.
+    let mut now_of = vec![u32::MAX; pc.gid.len()];
     let mut gid = Vec::with_capacity(d.was.len());
     let mut owner = Vec::with_capacity(d.was.len());
     for (j, w) in d.was.iter().enumerate() {
