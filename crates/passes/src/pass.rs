@@ -66,16 +66,21 @@ pub(crate) fn parallel_pass<C: Comm>(
         .collect();
     let inboxes = comm.exchange(outboxes);
 
-    // Every part meshes inside its region.
-    let made: Vec<Result<Made, (usize, FrontError)>> = inboxes
-        .into_par_iter()
+    // Every part meshes inside its region, and takes its result in at
+    // once.
+    let made: Vec<Result<Absorbed, (usize, FrontError)>> = parts
+        .par_iter_mut()
+        .zip(inboxes)
         .enumerate()
-        .map(|(i, inbox)| front_call(inbox, (start + i) as u32, regions, size))
+        .map(|(i, (part, inbox))| {
+            front_call(inbox, (start + i) as u32, regions, size)
+                .map(|m| absorb_local(part, m, pass))
+        })
         .collect();
     let made = crate::agree(comm, pass, made)?;
 
     // Global ids for the new points: an all-gather of the counts.
-    let counts = comm.all_gather(made.iter().map(Made::new_points).collect());
+    let counts = comm.all_gather(made.iter().map(|a| a.new_points).collect());
     let mut base = Vec::with_capacity(np);
     let mut acc = *next_gid;
     for c in &counts {
@@ -83,13 +88,11 @@ pub(crate) fn parallel_pass<C: Comm>(
         acc += c;
     }
     *next_gid = acc;
-    let secs = comm.all_gather(made.iter().map(|m| m.seconds).collect());
-    let tets: Vec<usize> = parts
-        .par_iter_mut()
-        .zip(made)
-        .zip(&base[start..])
-        .map(|((part, m), &base)| absorb(part, m, base, pass))
-        .collect();
+    let secs = comm.all_gather(made.iter().map(|a| a.seconds).collect());
+    for ((part, a), &b) in parts.iter_mut().zip(&made).zip(&base[start..]) {
+        absorb_finish(part, a, b);
+    }
+    let tets: Vec<usize> = made.iter().map(|a| a.tets).collect();
     Ok((comm.all_gather(tets), secs))
 }
 

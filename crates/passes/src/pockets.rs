@@ -210,7 +210,37 @@ fn fill_pocket(
 /// remaining faces it owns into the part's store. Context faces come back
 /// untouched and are dropped: their holder still has them.
 pub(super) fn absorb(part: &mut Part, m: Made, base: u32, pass: u8) -> usize {
-    let Some(r) = m.res else { return 0 };
+    let a = absorb_local(part, m, pass);
+    absorb_finish(part, &a, base);
+    a.tets
+}
+
+/// A front call taken into its part before its new points have global
+/// ids (they come from every part's count): [`absorb_finish`] gives them.
+pub(super) struct Absorbed {
+    /// The part's local id of the first new point; the rest follow.
+    first_new: u32,
+    pub(super) new_points: u32,
+    pub(super) tets: usize,
+    /// Local ids of the stuck faces' points, to be given as global ids.
+    stuck: Vec<u32>,
+    pub(super) seconds: f64,
+}
+
+/// [`absorb`] up to the new points' global ids: the tets, the faces and
+/// the points go into the part at once, so that a part's result is not
+/// held beside the next part's front (its adjacency was a sixth of an MPI
+/// rank's peak).
+pub(super) fn absorb_local(part: &mut Part, m: Made, pass: u8) -> Absorbed {
+    let Some(r) = m.res else {
+        return Absorbed {
+            first_new: 0,
+            new_points: 0,
+            tets: 0,
+            stuck: Vec::new(),
+            seconds: m.seconds,
+        };
+    };
     let n_in = m.input_gid.len();
     // Room made once: grown by doubling, the part's arrays were copied
     // while the pass's other results waited (a rank's peak under MPI).
@@ -219,27 +249,30 @@ pub(super) fn absorb(part: &mut Part, m: Made, base: u32, pass: u8) -> usize {
     part.size.reserve_exact(n_new);
     part.gid.reserve_exact(n_new);
     part.index.reserve(n_new);
-    let map: Vec<u32> = (0..r.points.len())
+    let mut map: Vec<u32> = (0..n_in)
         .map(|i| {
-            let gid = if i < n_in {
-                m.input_gid[i]
-            } else {
-                base + (i - n_in) as u32
-            };
             part.local(Rec {
-                gid,
+                gid: m.input_gid[i],
                 p: r.points[i],
                 h: r.point_size[i],
             })
         })
         .collect();
+    // The new points are new to the part: pushed in order, indexed later.
+    let first_new = part.pts.len() as u32;
+    for i in n_in..r.points.len() {
+        map.push(part.pts.len() as u32);
+        part.pts.push(r.points[i]);
+        part.size.push(r.point_size[i]);
+        part.gid.push(u32::MAX);
+    }
     let ok = |i: u32| (i as usize) >= n_in || m.input_ok[i as usize];
+    let mut stuck = Vec::new();
     for (j, f) in r.front.iter().enumerate() {
         if f.iter().all(|&i| ok(i)) {
             part.front.push(f.map(|i| map[i as usize]));
             if m.stuck.get(j) == Some(&true) {
-                part.stuck
-                    .extend(f.map(|i| part.gid[map[i as usize] as usize]));
+                stuck.extend(f.map(|i| map[i as usize]));
             }
         }
     }
@@ -254,7 +287,25 @@ pub(super) fn absorb(part: &mut Part, m: Made, base: u32, pass: u8) -> usize {
     }
     part.tet_pass.reserve_exact(n);
     part.tet_pass.resize(part.tet_pass.len() + n, pass);
-    n
+    Absorbed {
+        first_new,
+        new_points: n_new as u32,
+        tets: n,
+        stuck,
+        seconds: m.seconds,
+    }
+}
+
+/// The new points of `a` get their global ids from `base`, and the stuck
+/// faces' points theirs.
+pub(super) fn absorb_finish(part: &mut Part, a: &Absorbed, base: u32) {
+    for k in 0..a.new_points {
+        let l = a.first_new + k;
+        part.gid[l as usize] = base + k;
+        part.index.insert(base + k, l);
+    }
+    part.stuck
+        .extend(a.stuck.iter().map(|&l| part.gid[l as usize]));
 }
 
 /// Whether face `f` of a pass's result got stuck: the region rules of §7
