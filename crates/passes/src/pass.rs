@@ -89,9 +89,11 @@ pub(crate) fn parallel_pass<C: Comm>(
     }
     *next_gid = acc;
     let secs = comm.all_gather(made.iter().map(|a| a.seconds).collect());
-    for ((part, a), &b) in parts.iter_mut().zip(&made).zip(&base[start..]) {
-        absorb_finish(part, a, b);
-    }
+    parts
+        .par_iter_mut()
+        .zip(&made)
+        .zip(&base[start..])
+        .for_each(|((part, a), &b)| absorb_finish(part, a, b));
     let tets: Vec<usize> = made.iter().map(|a| a.tets).collect();
     Ok((comm.all_gather(tets), secs))
 }

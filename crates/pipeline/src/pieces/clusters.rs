@@ -1,7 +1,7 @@
 //! §9.4's last lift across the cuts of the pieces: the tets under the
 //! lift's floor near a cut, with the tets around them, gathered into one
 //! piece, so that a third round of improvement finds them inside it.
-use super::{gather_ids, MeshError};
+use super::{gather_ids, per_region, MeshError};
 use parafront_comm::Comm;
 use parafront_passes::Piece;
 
@@ -41,16 +41,12 @@ pub(super) fn move_clusters<C: Comm>(
     region: &[u32],
     bad: &[u32],
 ) -> Result<(), MeshError> {
-    let held = comm.owned().len();
     let start = comm.owned().start as u32;
-    let mut all = std::mem::take(pieces);
-    for &r in region {
-        let take = held.min(all.len());
-        let chunk: Vec<Piece> = all.drain(..take).collect();
-        let touches = |pc: &Piece, t: &[u32; 4], m: &[u32]| {
-            t.iter()
-                .any(|&j| m.binary_search(&pc.gid[j as usize]).is_ok())
-        };
+    let touches = |pc: &Piece, t: &[u32; 4], m: &[u32]| {
+        t.iter()
+            .any(|&j| m.binary_search(&pc.gid[j as usize]).is_ok())
+    };
+    per_region(comm, pieces, region, |chunk| {
         let mut m = bad.to_vec();
         for _ in 0..CLUSTER_LAYERS {
             m = gather_ids(comm, &chunk, |pc| {
@@ -94,15 +90,8 @@ pub(super) fn move_clusters<C: Comm>(
                     .collect()
             })
             .collect();
-        let moved = parafront_passes::move_pieces(comm, chunk, dst).map_err(|source| {
-            MeshError::Parallel {
-                region: r as usize,
-                source,
-            }
-        })?;
-        pieces.extend(moved);
-    }
-    Ok(())
+        parafront_passes::move_pieces(comm, chunk, dst)
+    })
 }
 
 /// Per global point of `tets` (part, points), sorted: the lowest part

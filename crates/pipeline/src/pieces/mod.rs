@@ -70,15 +70,22 @@ pub(crate) fn improve_pieces<C: Comm>(
     // points near it (sphere_5e6 at `--parts 8`: 16.2° -> 20°+).
     let tan = parafront_improve::LIFT_SWAP_DEG.to_radians().tan();
     let bad = gather_ids(comm, pieces, |pc| {
-        let near_cut = near_points(pc, pc.shared.iter().flatten().copied(), CLUSTER_LAYERS);
-        pc.tets
+        let under: Vec<&[u32; 4]> = pc
+            .tets
             .iter()
             .filter(|t| {
-                t.iter().any(|&j| near_cut[j as usize]) && {
-                    let p = t.map(|j| pc.points[j as usize]);
-                    parafront_improve::quality::has_dihedral_under(p, tan)
-                }
+                let p = t.map(|j| pc.points[j as usize]);
+                parafront_improve::quality::has_dihedral_under(p, tan)
             })
+            .collect();
+        // The layers around the cuts only where some tet is under.
+        if under.is_empty() {
+            return Vec::new();
+        }
+        let near_cut = near_points(pc, pc.shared.iter().flatten().copied(), CLUSTER_LAYERS);
+        under
+            .into_iter()
+            .filter(|t| t.iter().any(|&j| near_cut[j as usize]))
             .flat_map(|t| t.map(|j| pc.gid[j as usize]))
             .collect()
     });
@@ -119,16 +126,28 @@ fn gather_ids<C: Comm>(comm: &C, pieces: &[Piece], of: impl Fn(&Piece) -> Vec<u3
 /// §9.5's shift of every region's pieces: the tets at each cut go to the
 /// lower piece.
 fn shift_all<C: Comm>(comm: &C, pieces: &mut Vec<Piece>, region: &[u32]) -> Result<(), MeshError> {
+    per_region(comm, pieces, region, |chunk| {
+        parafront_passes::shift_pieces(comm, chunk)
+    })
+}
+
+/// The pieces this process holds, region by region (`held` of each), each
+/// region's given to `f` and replaced by what it makes of them.
+fn per_region<C: Comm>(
+    comm: &C,
+    pieces: &mut Vec<Piece>,
+    region: &[u32],
+    mut f: impl FnMut(Vec<Piece>) -> Result<Vec<Piece>, parafront_passes::PassError>,
+) -> Result<(), MeshError> {
     let held = comm.owned().len();
     let mut all = std::mem::take(pieces);
     for &r in region {
         let take = held.min(all.len());
         let chunk: Vec<Piece> = all.drain(..take).collect();
-        let moved =
-            parafront_passes::shift_pieces(comm, chunk).map_err(|source| MeshError::Parallel {
-                region: r as usize,
-                source,
-            })?;
+        let moved = f(chunk).map_err(|source| MeshError::Parallel {
+            region: r as usize,
+            source,
+        })?;
         pieces.extend(moved);
     }
     Ok(())
