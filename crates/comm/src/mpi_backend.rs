@@ -135,13 +135,12 @@ impl Mpi {
     }
 
     /// `bufs[q]` goes to rank `q`; the answer's `[q]` came from rank `q`.
-    fn all_to_all_bytes(&self, bufs: Vec<Vec<u8>>) -> Vec<Vec<u8>> {
+    fn all_to_all_bytes(&self, bufs: Vec<Vec<u8>>) -> Received {
         let world = self.universe.world();
         let lens: Vec<u64> = bufs.iter().map(|b| b.len() as u64).collect();
         let mut rlens = vec![0u64; self.ranks];
         world.all_to_all_into(&lens[..], &mut rlens[..]);
-        let (send, scounts, sdispls) = pack_words(&bufs);
-        drop(bufs);
+        let (send, scounts, sdispls) = pack_words(bufs);
         let (rcounts, rdispls) = layout(rlens.iter().map(|&n| words(n)));
         let mut recv = vec![0u64; rcounts.iter().map(|&c| c as usize).sum()];
         {
@@ -149,23 +148,22 @@ impl Mpi {
             let mut rp = PartitionMut::new(&mut recv[..], &rcounts[..], &rdispls[..]);
             world.all_to_all_varcount_into(&sp, &mut rp);
         }
-        unpack_words(&recv, &rdispls, &rlens)
+        Received::new(recv, &rdispls, &rlens)
     }
 
     /// Every rank's `buf`, indexed by rank.
-    fn all_gather_bytes(&self, buf: Vec<u8>) -> Vec<Vec<u8>> {
+    fn all_gather_bytes(&self, buf: Vec<u8>) -> Received {
         let world = self.universe.world();
         let mut rlens = vec![0u64; self.ranks];
         world.all_gather_into(&(buf.len() as u64), &mut rlens[..]);
-        let (send, _, _) = pack_words(std::slice::from_ref(&buf));
-        drop(buf);
+        let (send, _, _) = pack_words(vec![buf]);
         let (rcounts, rdispls) = layout(rlens.iter().map(|&n| words(n)));
         let mut recv = vec![0u64; rcounts.iter().map(|&c| c as usize).sum()];
         {
             let mut rp = PartitionMut::new(&mut recv[..], &rcounts[..], &rdispls[..]);
             world.all_gather_varcount_into(&send[..], &mut rp);
         }
-        unpack_words(&recv, &rdispls, &rlens)
+        Received::new(recv, &rdispls, &rlens)
     }
 }
 
@@ -205,39 +203,43 @@ fn layout(counts: impl Iterator<Item = usize>) -> (Vec<i32>, Vec<i32>) {
 }
 
 /// The buffers as consecutive blocks of words (zero-padded), with their
-/// counts and displacements.
-fn pack_words(bufs: &[Vec<u8>]) -> (Vec<u64>, Vec<i32>, Vec<i32>) {
+/// counts and displacements; each buffer is freed once copied, so that a
+/// large message is held about once, not twice.
+fn pack_words(bufs: Vec<Vec<u8>>) -> (Vec<u64>, Vec<i32>, Vec<i32>) {
     let (counts, displs) = layout(bufs.iter().map(|b| words(b.len() as u64)));
-    let mut out = Vec::with_capacity(counts.iter().map(|&c| c as usize).sum());
-    for b in bufs {
-        let mut chunks = b.chunks_exact(8);
-        for c in &mut chunks {
-            out.push(u64::from_le_bytes(c.try_into().expect("8 bytes")));
-        }
-        let rest = chunks.remainder();
-        if !rest.is_empty() {
-            let mut w = [0u8; 8];
-            w[..rest.len()].copy_from_slice(rest);
-            out.push(u64::from_le_bytes(w));
-        }
+    // Zeroed pages are only touched as they are written.
+    let mut out = vec![0u64; counts.iter().map(|&c| c as usize).sum()];
+    let bytes: &mut [u8] = bytemuck::cast_slice_mut(&mut out);
+    for (b, &d) in bufs.into_iter().zip(&displs) {
+        let at = 8 * d as usize;
+        bytes[at..at + b.len()].copy_from_slice(&b);
     }
     (out, counts, displs)
 }
 
-/// The byte buffers of `lens[q]` bytes at word `displs[q]` of `recv`.
-fn unpack_words(recv: &[u64], displs: &[i32], lens: &[u64]) -> Vec<Vec<u8>> {
-    lens.iter()
-        .zip(displs)
-        .map(|(&n, &d)| {
-            let n = n as usize;
-            let mut b = Vec::with_capacity(n.next_multiple_of(8));
-            for w in &recv[d as usize..d as usize + words(n as u64)] {
-                b.extend_from_slice(&w.to_le_bytes());
-            }
-            b.truncate(n);
-            b
-        })
-        .collect()
+/// What a collective call received: each rank's bytes, read in place
+/// from the words they came in (no second copy of a large message).
+struct Received {
+    words: Vec<u64>,
+    /// Per rank, its first byte and its length.
+    at: Vec<(usize, usize)>,
+}
+
+impl Received {
+    /// `lens[q]` bytes from rank `q`, at word `displs[q]` of `words`.
+    fn new(words: Vec<u64>, displs: &[i32], lens: &[u64]) -> Received {
+        let at = displs
+            .iter()
+            .zip(lens)
+            .map(|(&d, &n)| (8 * d as usize, n as usize))
+            .collect();
+        Received { words, at }
+    }
+
+    fn bytes(&self, q: usize) -> &[u8] {
+        let (a, n) = self.at[q];
+        &bytemuck::cast_slice::<u64, u8>(&self.words)[a..a + n]
+    }
 }
 
 /// A message that does not decode is a bug on some rank: end them all.
@@ -283,7 +285,7 @@ impl Comm for Mpi {
         let recv = self.all_to_all_bytes(bufs);
         let mut inbox: Vec<Vec<(u32, T)>> = own.clone().map(|_| Vec::new()).collect();
         let mut here = Some(here);
-        for (q, bytes) in recv.iter().enumerate() {
+        for q in 0..self.ranks {
             if q == self.rank {
                 for (src, dst, m) in here.take().expect("once") {
                     inbox[dst as usize - own.start].push((src, m));
@@ -291,7 +293,7 @@ impl Comm for Mpi {
                 continue;
             }
             let from = self.block(q);
-            let mut b = &bytes[..];
+            let mut b = recv.bytes(q);
             while !b.is_empty() {
                 let src: u32 = decode(&mut b, q);
                 let dst: u32 = decode(&mut b, q);
@@ -316,12 +318,12 @@ impl Comm for Mpi {
         let all = self.all_gather_bytes(buf);
         let mut res = Vec::with_capacity(self.parts);
         let mut local = Some(local);
-        for (q, bytes) in all.iter().enumerate() {
+        for q in 0..self.ranks {
             if q == self.rank {
                 res.extend(local.take().expect("once"));
                 continue;
             }
-            let mut b = &bytes[..];
+            let mut b = all.bytes(q);
             for _ in self.block(q) {
                 res.push(decode(&mut b, q));
             }
@@ -346,10 +348,13 @@ mod tests {
     #[test]
     fn words_round_trip() {
         let bufs = vec![vec![], vec![1u8, 2, 3], (0..16).collect(), vec![9; 9]];
-        let (w, c, d) = pack_words(&bufs);
+        let lens: Vec<u64> = bufs.iter().map(|b| b.len() as u64).collect();
+        let (w, c, d) = pack_words(bufs.clone());
         assert_eq!(c, vec![0, 1, 2, 2]);
         assert_eq!(d, vec![0, 0, 1, 3]);
-        let lens: Vec<u64> = bufs.iter().map(|b| b.len() as u64).collect();
-        assert_eq!(unpack_words(&w, &d, &lens), bufs);
+        let r = Received::new(w, &d, &lens);
+        for (q, b) in bufs.iter().enumerate() {
+            assert_eq!(r.bytes(q), &b[..]);
+        }
     }
 }

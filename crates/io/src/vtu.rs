@@ -525,20 +525,23 @@ pub fn write_pvtu(
     opts: &WriteOptions,
 ) -> Result<Vec<PathBuf>, IoError> {
     let ids: Vec<usize> = (0..parts.len()).collect();
-    write_pvtu_share(path, &ids, &ids, true, parts, opts)
+    write_pvtu_share(path, &ids, &ids, true, parts, |p| (*p).clone(), opts)
 }
 
 /// [`write_pvtu`] for one process's share of a partitioned mesh (MPI):
-/// `parts[i]` is written as `<stem>_<ids[i]>.vtu`; with `index`, the index
-/// at `path` names the pieces `listed` (the other processes' pieces carry
-/// the same arrays). Returns the parts' paths; on error no file of this
-/// call remains.
-pub fn write_pvtu_share(
+/// the `i`th of `parts`, as `piece` shows it, is written as
+/// `<stem>_<ids[i]>.vtu`; with `index`, the index at `path` names the
+/// pieces `listed` (the other processes' pieces carry the same arrays).
+/// The parts are taken one at a time, each dropped once written: a caller
+/// that makes their arrays as they come holds one piece's copy, not all.
+/// Returns the parts' paths; on error no file of this call remains.
+pub fn write_pvtu_share<T>(
     path: &Path,
     ids: &[usize],
     listed: &[usize],
     index: bool,
-    parts: &[Piece],
+    parts: impl IntoIterator<Item = T>,
+    piece: impl Fn(&T) -> Piece<'_>,
     opts: &WriteOptions,
 ) -> Result<Vec<PathBuf>, IoError> {
     let stem = path
@@ -558,7 +561,7 @@ pub fn write_pvtu_share(
     let mut sig: Option<Signature> = None;
     for (&k, part) in ids.iter().zip(parts) {
         let pp = path.with_file_name(format!("{stem}_{k}.vtu"));
-        match write_piece(&pp, part, opts) {
+        match write_piece(&pp, &piece(&part), opts) {
             Ok(s) => {
                 written.push(pp);
                 if let Some(s0) = &sig {

@@ -371,7 +371,14 @@ pub(crate) fn build_ddg_at<C: Comm>(
             break;
         }
         let cells = Cells::new(&cen, np, frame(j), &domain);
-        let (tets, _) = parallel_pass(&mut parts, comm, &cells, sizes, j as u8 + 1, &mut next_gid)?;
+        let (tets, _) = parallel_pass(
+            &mut parts,
+            comm,
+            &cells,
+            sizes,
+            (j as u8 + 1, None),
+            &mut next_gid,
+        )?;
         let peeled = peel_stuck(&mut parts, comm);
         crate::debug_check_parts(&parts, "a DDG pass");
         if debug {

@@ -78,6 +78,10 @@ pub struct ParOptions {
     /// Merge the pieces into one mesh on part 0's process (true), or leave
     /// them where they are (a partitioned output, memory distributed).
     pub gather: bool,
+    /// Hands freed memory back to the system (the CLI: glibc's
+    /// `malloc_trim`), called once the DDG is split and after each part's
+    /// front; `None` leaves it to the allocator.
+    pub release: Option<fn()>,
 }
 
 pub use ddg_build::DDG_CAP;
@@ -99,6 +103,15 @@ impl Default for ParOptions {
             ddg_cap: ddg_build::DDG_CAP,
             fail_part: None,
             gather: true,
+            release: None,
+        }
+    }
+}
+
+impl ParOptions {
+    pub(crate) fn released(&self) {
+        if let Some(f) = self.release {
+            f();
         }
     }
 }
@@ -435,6 +448,9 @@ pub fn mesh_parallel_around<C: Comm>(
     rec.ddg(&d, built, t_ddg.elapsed().as_secs_f64());
     // §6 step 2: weights and the balanced split.
     let (loc, w, base) = split_ddg(&d, size, opts, np, &mut rec);
+    // The DDG's build leaves its fronts' memory free in the allocator's
+    // heaps; a process's peak comes later, in pass 1.
+    opts.released();
 
     let all: Vec<[u32; 3]>;
     let faces = if core.is_empty() {

@@ -9,12 +9,14 @@ use super::*;
 /// box it meets (so that each part knows every face bounding its region);
 /// every part advances its faces; new points get global ids. Returns the
 /// tets and the front seconds of every part (`parts` are the owned ones).
+/// `release` runs after each part's front (a process's parts run one after
+/// another on one thread, and each front's memory is freed in pieces).
 pub(crate) fn parallel_pass<C: Comm>(
     parts: &mut [Part],
     comm: &C,
     regions: &dyn Regions,
     size: Sizes<'_>,
-    pass: u8,
+    (pass, release): (u8, Option<fn()>),
     next_gid: &mut u32,
 ) -> Result<(Vec<usize>, Vec<f64>), PassError> {
     let np = comm.parts();
@@ -32,14 +34,15 @@ pub(crate) fn parallel_pass<C: Comm>(
         })
         .collect();
 
-    // Each holder sorts its faces out.
-    let outboxes: Vec<Vec<(u32, FaceMsg)>> = parts
+    // Each holder sorts its faces out: one batch per destination.
+    let outboxes: Vec<Vec<(u32, FaceBatch)>> = parts
         .par_iter_mut()
         .map(|part| {
             let mut owner: Vec<Option<Option<u32>>> = vec![None; part.pts.len()];
-            let mut out = Vec::new();
+            // (destination, face, owned there), in face order.
+            let mut to: Vec<(u32, u32, bool)> = Vec::new();
             let mut keep = Vec::new();
-            for &f in &part.front {
+            for (fi, &f) in part.front.iter().enumerate() {
                 let o = f.map(|i| {
                     *owner[i as usize].get_or_insert_with(|| regions.owner(part.pts[i as usize]))
                 });
@@ -48,17 +51,45 @@ pub(crate) fn parallel_pass<C: Comm>(
                 } else {
                     None
                 };
-                let v = f.map(|i| part.rec(i));
-                let fb = Aabb::from_points(v.iter().map(|r| &r.p));
+                let fb = Aabb::from_points(f.iter().map(|&i| &part.pts[i as usize]));
                 for (q, b) in boxes.iter().enumerate() {
                     if Some(q as u32) != own && b.overlaps(&fb) {
-                        out.push((q as u32, FaceMsg { owned: false, v }));
+                        to.push((q as u32, fi as u32, false));
                     }
                 }
                 match own {
-                    Some(k) => out.push((k, FaceMsg { owned: true, v })),
+                    Some(k) => to.push((k, fi as u32, true)),
                     None => keep.push(f),
                 }
+            }
+            drop(owner);
+            // By destination, each in face order (a stable sort).
+            to.sort_by_key(|x| x.0);
+            // Per point, its index in the batch being built.
+            let mut at = vec![u32::MAX; part.pts.len()];
+            let mut ids: Vec<u32> = Vec::new();
+            let mut out = Vec::new();
+            for group in to.chunk_by(|a, b| a.0 == b.0) {
+                let mut b = FaceBatch::default();
+                for &(_, fi, owned) in group {
+                    let v = part.front[fi as usize].map(|i| {
+                        if at[i as usize] == u32::MAX {
+                            at[i as usize] = ids.len() as u32;
+                            ids.push(i);
+                        }
+                        at[i as usize]
+                    });
+                    if owned {
+                        b.owned.push(v);
+                    } else {
+                        b.context.push(v);
+                    }
+                }
+                b.points = ids.iter().map(|&i| part.rec(i)).collect();
+                for i in ids.drain(..) {
+                    at[i as usize] = u32::MAX;
+                }
+                out.push((group[0].0, b));
             }
             part.front = keep;
             out
@@ -73,8 +104,12 @@ pub(crate) fn parallel_pass<C: Comm>(
         .zip(inboxes)
         .enumerate()
         .map(|(i, (part, inbox))| {
-            front_call(inbox, (start + i) as u32, regions, size)
-                .map(|m| absorb_local(part, m, pass))
+            let made = front_call(inbox, (start + i) as u32, regions, size)
+                .map(|m| absorb_local(part, m, pass));
+            if let Some(f) = release {
+                f();
+            }
+            made
         })
         .collect();
     let made = crate::agree(comm, pass, made)?;
@@ -101,13 +136,14 @@ pub(crate) fn parallel_pass<C: Comm>(
 /// Builds one part's front from its inbox (owned faces first, then the
 /// context) and advances it in pass mode under its region filter.
 pub(crate) fn front_call(
-    inbox: Vec<(u32, FaceMsg)>,
+    inbox: Vec<(u32, FaceBatch)>,
     k: u32,
     regions: &dyn Regions,
     size: Sizes<'_>,
 ) -> Result<Made, (usize, FrontError)> {
     let t0 = Instant::now();
-    if !inbox.iter().any(|m| m.1.owned) {
+    let n_owned: usize = inbox.iter().map(|(_, b)| b.owned.len()).sum();
+    if n_owned == 0 {
         return Ok(Made {
             res: None,
             input_gid: Vec::new(),
@@ -116,13 +152,12 @@ pub(crate) fn front_call(
             seconds: 0.0,
         });
     }
-    let n_owned = inbox.iter().filter(|m| m.1.owned).count();
     // Owned faces first: their points get the low local ids.
     let (input, gids) = local_front(
-        [true, false]
-            .into_iter()
-            .flat_map(|owned| inbox.iter().filter(move |m| m.1.owned == owned))
-            .map(|(_, m)| &m.v),
+        inbox
+            .iter()
+            .flat_map(|(_, b)| b.faces(&b.owned))
+            .chain(inbox.iter().flat_map(|(_, b)| b.faces(&b.context))),
     );
     // The messages are copied into `input`: not held while the front runs.
     drop(inbox);

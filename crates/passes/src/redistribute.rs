@@ -40,8 +40,10 @@ fn key(p: P3) -> Key {
     p.map(|x| (x + 0.0).to_bits())
 }
 
-/// A piece with its points' exact keys (for the shared lists).
-type Keyed = (Piece, FxHashMap<Key, u32>);
+/// A piece with its points' local ids in the order of their exact keys
+/// (for the shared lists; a hash map by key was 8.7 MB a piece of 120k
+/// points, held over a process's peak).
+type Keyed = (Piece, Vec<u32>);
 
 /// The tets one part sends another: their points once each (global id,
 /// where it is), then the tets by global ids and the pass that made each.
@@ -303,41 +305,53 @@ fn batches(
     out
 }
 
-/// Each part's received tets as a piece, its points once by exact key
-/// (with the key map, for the shared lists).
+/// Each part's received tets as a piece, its points once (by global id,
+/// then checked by exact key), with their order by key.
 fn receive_tets(inbox: Vec<Vec<(u32, Batch)>>) -> Result<Vec<Keyed>, PassError> {
     inbox
         .into_par_iter()
         .map(|msgs| {
             let mut pc = Piece::default();
-            let mut map: FxHashMap<Key, u32> = FxHashMap::default();
+            let mut local: FxHashMap<u32, u32> = FxHashMap::default();
             for (_, b) in msgs {
-                let at: FxHashMap<u32, P3> = b.points.into_iter().collect();
+                let at: FxHashMap<u32, u32> = (b.points.iter().enumerate())
+                    .map(|(i, p)| (p.0, i as u32))
+                    .collect();
                 for (tv, pass) in b.tets.into_iter().zip(b.pass) {
-                    let mut t = [0u32; 4];
-                    for (c, g) in tv.into_iter().enumerate() {
-                        let p = at[&g];
-                        let i = *map.entry(key(p)).or_insert_with(|| {
-                            pc.points.push(p);
+                    let t = tv.map(|g| {
+                        *local.entry(g).or_insert_with(|| {
+                            pc.points.push(b.points[at[&g] as usize].1);
                             pc.gid.push(g);
                             pc.points.len() as u32 - 1
-                        });
-                        if pc.gid[i as usize] != g {
-                            return Err(PassError::Coincident {
-                                a: pc.gid[i as usize],
-                                b: g,
-                                at: p,
-                            });
-                        }
-                        t[c] = i;
-                    }
+                        })
+                    });
                     pc.tets.push(t);
                     pc.tet_pass.push(pass);
                 }
             }
-            Ok((pc, map))
+            drop(local);
+            let by_key = by_key(&pc)?;
+            Ok((pc, by_key))
         })
         .collect::<Result<_, PassError>>()
+}
+
+/// The piece's points in the order of their exact keys, or the first two
+/// global ids at one place.
+fn by_key(pc: &Piece) -> Result<Vec<u32>, PassError> {
+    let mut order: Vec<u32> = (0..pc.points.len() as u32).collect();
+    order.sort_unstable_by_key(|&i| (key(pc.points[i as usize]), i));
+    for w in order.windows(2) {
+        let (a, b) = (w[0] as usize, w[1] as usize);
+        if key(pc.points[a]) == key(pc.points[b]) {
+            return Err(PassError::Coincident {
+                a: pc.gid[a],
+                b: pc.gid[b],
+                at: pc.points[a],
+            });
+        }
+    }
+    Ok(order)
 }
 
 /// Global tet numbers: by part, then local order.
@@ -396,10 +410,16 @@ fn share_points<C: Comm>(comm: &C, pieces: &mut [Keyed]) {
         .par_iter_mut()
         .zip(inbox)
         .enumerate()
-        .for_each(|(i, ((pc, map), msgs))| {
+        .for_each(|(i, ((pc, by_key), msgs))| {
             pc.owner = vec![(start + i) as u32; pc.points.len()];
+            let find = |x: &Key| {
+                by_key
+                    .binary_search_by(|&j| key(pc.points[j as usize]).cmp(x))
+                    .ok()
+                    .map(|at| by_key[at])
+            };
             for (q, keys) in msgs {
-                let mut sh: Vec<u32> = keys.iter().filter_map(|x| map.get(x).copied()).collect();
+                let mut sh: Vec<u32> = keys.iter().filter_map(find).collect();
                 if sh.is_empty() {
                     continue;
                 }
@@ -463,4 +483,48 @@ fn merge(
         return Err(PassError::Unused { point: g as u32 });
     }
     Ok((points, tets, tet_pass))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn piece(points: Vec<P3>) -> Piece {
+        Piece {
+            gid: (0..points.len() as u32).map(|i| 10 + i).collect(),
+            points,
+            ..Piece::default()
+        }
+    }
+
+    /// The points in the order of their exact keys (-0.0 is 0.0), and two
+    /// global ids at one place named, the first-met first.
+    #[test]
+    fn points_by_key_and_coincident_ones() {
+        let pc = piece(vec![
+            [1.0, 0.0, 0.0],
+            [0.0, 2.0, 0.0],
+            [0.5, 0.0, 0.0],
+            [-0.0, 1.0, 0.0],
+        ]);
+        let order = by_key(&pc).unwrap();
+        let keys: Vec<Key> = order.iter().map(|&i| key(pc.points[i as usize])).collect();
+        assert!(keys.windows(2).all(|w| w[0] < w[1]));
+        let mut seen = order.clone();
+        seen.sort_unstable();
+        assert_eq!(seen, vec![0, 1, 2, 3]);
+        let pc = piece(vec![
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, 2.0, 0.0],
+            [-0.0, 1.0, 0.0],
+        ]);
+        match by_key(&pc) {
+            Err(PassError::Coincident { a, b, at }) => {
+                assert_eq!((a, b), (11, 13));
+                assert_eq!(key(at), key([0.0, 1.0, 0.0]));
+            }
+            other => panic!("{:?}", other.map(|_| ())),
+        }
+    }
 }

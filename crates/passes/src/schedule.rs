@@ -212,7 +212,14 @@ impl<C: Comm> Passes<'_, C> {
             part_of,
         };
         let size = Sizes::fine(self.size);
-        let (tets, secs) = parallel_pass(parts, self.comm, &regions, size, step.pass(), next_gid)?;
+        let (tets, secs) = parallel_pass(
+            parts,
+            self.comm,
+            &regions,
+            size,
+            (step.pass(), self.opts.release),
+            next_gid,
+        )?;
         if tracing::enabled!(tracing::Level::DEBUG) {
             let fr: usize = parts.iter().map(|p| p.front.len()).sum();
             let stuck: usize = parts.iter().map(|p| p.stuck.len() / 3).sum();

@@ -99,7 +99,7 @@ pub(super) fn remove_touching(
 /// unordered triple, then match the two orientations one for one.
 /// A front over global points, numbered locally in the order the points
 /// are first met, with the global id of each local point.
-pub(super) fn local_front<'a>(faces: impl Iterator<Item = &'a [Rec; 3]>) -> (FrontInput, Vec<u32>) {
+pub(super) fn local_front(faces: impl Iterator<Item = [Rec; 3]>) -> (FrontInput, Vec<u32>) {
     let mut index: FxHashMap<u32, u32> = FxHashMap::default();
     let (mut points, mut point_size, mut gids) = (Vec::new(), Vec::new(), Vec::new());
     let faces = faces
@@ -295,7 +295,7 @@ fn pass4_try(
     retry: bool,
     fill_after: u32,
 ) -> Try4 {
-    let (input, gids) = local_front(hole.iter());
+    let (input, gids) = local_front(hole.iter().copied());
     let t0 = Instant::now();
     let res = advance(
         input,

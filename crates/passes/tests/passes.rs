@@ -345,3 +345,44 @@ fn inner_parts_start_from_a_seed() {
     // 32 parts of 4k tets: pass 4 takes about 1 %.
     assert!((st.pass_tets[3] as f64) < 0.03 * n);
 }
+
+static RELEASED: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+
+fn count_release() {
+    RELEASED.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+}
+
+/// The release hook runs once after the DDG's split and once after each
+/// part's front in each fine pass, and leaves the mesh as it is.
+#[test]
+fn the_release_hook_runs_between_fronts_and_changes_nothing() {
+    let s = generate::icosphere([0.0; 3], 1.0, 3);
+    let field = move |_p: P3| 0.12;
+    let faces: Vec<[u32; 3]> = s.tris.iter().map(|t| [t[0], t[2], t[1]]).collect();
+    let hs: Vec<f64> = s.mean_edge_lengths();
+    let go = |release: Option<fn()>| {
+        mesh_parallel(
+            &s.points,
+            &hs,
+            &faces,
+            &field,
+            &ParOptions {
+                parts: 4,
+                release,
+                ..ParOptions::default()
+            },
+            &Threads::new(4),
+        )
+        .unwrap()
+    };
+    let plain = go(None);
+    assert_eq!(RELEASED.load(std::sync::atomic::Ordering::Relaxed), 0);
+    let hooked = go(Some(count_release));
+    let n = RELEASED.load(std::sync::atomic::Ordering::Relaxed);
+    // The split, then 4 parts in at least passes 1 to 3.
+    assert!(n > 12, "released {n} times");
+    assert_eq!(n % 4, 1, "released {n} times: once, then per part");
+    assert_eq!(plain.tets, hooked.tets);
+    assert_eq!(bits(&plain.points), bits(&hooked.points));
+    check(&s, &hooked);
+}

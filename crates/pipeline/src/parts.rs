@@ -41,6 +41,7 @@ pub(crate) fn mesh_parts<C: Comm>(
         ddg_cap: opts.ddg_cap,
         fail_part: opts.fail_part,
         gather: opts.gather,
+        release: opts.release_memory,
         ..ParOptions::default()
     };
     // Seconds of each of `Stage::PARALLEL`, summed over the regions.

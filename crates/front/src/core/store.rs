@@ -9,20 +9,23 @@
 //! (`fill_pockets`).
 //!
 //! A pass's front (§7) leaves its faces on the part's walls alive to the
-//! end, a few in nearly every chunk: at sphere_5e6 `--size 0.021`, a part
-//! of 640k tets kept 859 of its 1281 chunks (17 MB) for 31k live faces.
-//! A chunk down to [`SPARSE_AT`] live faces gives them to a hash map and
-//! goes.
+//! end, a few in nearly every chunk, and a front that grows ragged keeps
+//! old faces alive everywhere: at sphere_5e6 `--size 0.021`, a part of
+//! 640k tets held up to 970 chunks (19 MB) for at most 180k live faces.
+//! A chunk (not the last) down to [`PACK_AT`] live faces keeps them alone,
+//! with a bit mask of which they are, and is packed again each time half
+//! of them have died: the store holds at most about twice its live faces.
 use super::Face;
-use rustc_hash::FxHashMap;
 use std::ops::{Index, IndexMut};
 
 /// Faces per chunk (20 KB).
 const BITS: u32 = 10;
 const MASK: usize = (1 << BITS) - 1;
-/// Live faces at which a chunk (not the last) moves them to the map: a
-/// face there takes about 30 bytes against the chunk's 20 KB.
-const SPARSE_AT: u32 = 64;
+const WORDS: usize = (MASK + 1) / 64;
+/// Live faces at which a chunk (not the last) is packed: its live faces
+/// alone, with a mask of which they are (20 bytes a face and 160 a chunk,
+/// against the full chunk's 20 KB).
+const PACK_AT: u32 = 384;
 
 /// What a face of a freed chunk reads as: dead, with corners and owner
 /// out of any range, so that code using a dead face's corners (which
@@ -34,13 +37,62 @@ const DEAD: Face = Face {
     alive: false,
 };
 
+/// A chunk's faces: every slot, only the live ones, or none.
+enum Chunk {
+    Full(Box<[Face]>),
+    Packed(Box<Packed>),
+    Gone,
+}
+
+/// The faces of a chunk's set bits in `mask`, in id order; a face that
+/// dies keeps its slot (dead) until the chunk is packed again.
+struct Packed {
+    mask: [u64; WORDS],
+    /// Set bits in the words before each word.
+    before: [u16; WORDS],
+    faces: Box<[Face]>,
+}
+
+impl Packed {
+    /// A chunk's live faces, each with its offset in the chunk, in order.
+    fn new<'a>(live: impl Iterator<Item = (usize, &'a Face)>, n: u32) -> Packed {
+        let mut mask = [0u64; WORDS];
+        let mut faces = Vec::with_capacity(n as usize);
+        for (i, f) in live.filter(|x| x.1.alive) {
+            mask[i >> 6] |= 1 << (i & 63);
+            faces.push(*f);
+        }
+        let mut before = [0u16; WORDS];
+        for w in 1..WORDS {
+            before[w] = before[w - 1] + mask[w - 1].count_ones() as u16;
+        }
+        Packed {
+            mask,
+            before,
+            faces: faces.into_boxed_slice(),
+        }
+    }
+
+    /// Slot of chunk offset `i` in `faces`, if it has one.
+    #[inline]
+    fn slot(&self, i: usize) -> Option<usize> {
+        let (w, b) = (i >> 6, i & 63);
+        let m = self.mask[w];
+        ((m >> b) & 1 == 1)
+            .then(|| self.before[w] as usize + (m & ((1u64 << b) - 1)).count_ones() as usize)
+    }
+
+    /// Chunk offset of each slot, in order.
+    fn offsets(&self) -> impl Iterator<Item = usize> + '_ {
+        (0..MASK + 1).filter(|&i| (self.mask[i >> 6] >> (i & 63)) & 1 == 1)
+    }
+}
+
 #[derive(Default)]
 pub(super) struct Faces {
-    chunks: Vec<Option<Box<[Face]>>>,
+    chunks: Vec<Chunk>,
     /// Live faces per chunk.
     live: Vec<u32>,
-    /// The live faces of freed chunks that still have some, by id.
-    sparse: FxHashMap<u32, Face>,
     len: usize,
 }
 
@@ -55,41 +107,51 @@ impl Faces {
         let (c, i) = (self.len >> BITS, self.len & MASK);
         if i == 0 {
             self.chunks
-                .push(Some(vec![DEAD; MASK + 1].into_boxed_slice()));
+                .push(Chunk::Full(vec![DEAD; MASK + 1].into_boxed_slice()));
             self.live.push(0);
         }
-        self.chunks[c].as_mut().expect("the last chunk is kept")[i] = f;
+        match &mut self.chunks[c] {
+            Chunk::Full(ch) => ch[i] = f,
+            _ => unreachable!("the last chunk is kept whole"),
+        }
         self.live[c] += 1;
         self.len += 1;
     }
 
     /// Marks live face `id` dead; frees its chunk when that was the
-    /// chunk's last live face (the last chunk stays, faces go there next),
-    /// and moves the live faces of a chunk down to [`SPARSE_AT`] to the map.
+    /// chunk's last live face, and packs a chunk (not the last: faces go
+    /// there next) down to [`PACK_AT`] live faces, or a packed one down
+    /// to half its slots.
     pub(super) fn kill(&mut self, id: usize) {
-        let c = id >> BITS;
+        let (c, i) = (id >> BITS, id & MASK);
         self.live[c] -= 1;
-        match self.chunks[c].as_mut() {
-            Some(ch) => {
-                let f = &mut ch[id & MASK];
-                debug_assert!(f.alive);
-                f.alive = false;
-            }
-            None => {
-                let f = self.sparse.remove(&(id as u32));
-                debug_assert!(f.is_some_and(|f| f.alive));
-                return;
-            }
-        }
         let n = self.live[c];
-        if n <= SPARSE_AT && c + 1 < self.chunks.len() {
-            if let Some(ch) = self.chunks[c].take() {
-                let base = (c << BITS) as u32;
-                for (i, f) in ch.iter().enumerate().filter(|x| x.1.alive) {
-                    self.sparse.insert(base + i as u32, *f);
-                }
+        let last = c + 1 == self.chunks.len();
+        let repack = match &mut self.chunks[c] {
+            Chunk::Full(ch) => {
+                debug_assert!(ch[i].alive);
+                ch[i].alive = false;
+                n <= PACK_AT && !last
             }
+            Chunk::Packed(p) => {
+                let k = p.slot(i).expect("a live face has a slot");
+                debug_assert!(p.faces[k].alive);
+                p.faces[k].alive = false;
+                n == 0 || 2 * n as usize <= p.faces.len()
+            }
+            Chunk::Gone => unreachable!("a live face's chunk is kept"),
+        };
+        if !repack {
+            return;
         }
+        self.chunks[c] = match std::mem::replace(&mut self.chunks[c], Chunk::Gone) {
+            _ if n == 0 => Chunk::Gone,
+            Chunk::Full(ch) => Chunk::Packed(Box::new(Packed::new(ch.iter().enumerate(), n))),
+            Chunk::Packed(p) => {
+                Chunk::Packed(Box::new(Packed::new(p.offsets().zip(p.faces.iter()), n)))
+            }
+            Chunk::Gone => Chunk::Gone,
+        };
     }
 
     /// Every face by id, the dead ones included.
@@ -104,9 +166,9 @@ impl Index<usize> for Faces {
     fn index(&self, id: usize) -> &Face {
         assert!(id < self.len, "face {id} of {}", self.len);
         match &self.chunks[id >> BITS] {
-            Some(c) => &c[id & MASK],
-            None if self.live[id >> BITS] == 0 => &DEAD,
-            None => self.sparse.get(&(id as u32)).unwrap_or(&DEAD),
+            Chunk::Full(c) => &c[id & MASK],
+            Chunk::Packed(p) => p.slot(id & MASK).map_or(&DEAD, |k| &p.faces[k]),
+            Chunk::Gone => &DEAD,
         }
     }
 }
@@ -116,9 +178,13 @@ impl IndexMut<usize> for Faces {
     #[inline]
     fn index_mut(&mut self, id: usize) -> &mut Face {
         assert!(id < self.len, "face {id} of {}", self.len);
-        match self.chunks[id >> BITS].as_mut() {
-            Some(c) => &mut c[id & MASK],
-            None => self.sparse.get_mut(&(id as u32)).expect("a live face"),
+        match &mut self.chunks[id >> BITS] {
+            Chunk::Full(c) => &mut c[id & MASK],
+            Chunk::Packed(p) => {
+                let k = p.slot(id & MASK).expect("a live face");
+                &mut p.faces[k]
+            }
+            Chunk::Gone => panic!("face {id} is dead"),
         }
     }
 }
@@ -137,8 +203,9 @@ mod tests {
     }
 
     /// Against a plain vector: the same faces by id, whatever dies in
-    /// which order; no chunk kept with [`SPARSE_AT`] live faces or fewer
-    /// but the last, and the map holds the live faces of the others.
+    /// which order; no chunk but the last kept whole with [`PACK_AT`] live
+    /// faces or fewer, a packed chunk holds under twice its live faces,
+    /// and a chunk with none is gone.
     #[test]
     fn same_as_a_vector_and_frees_empty_chunks() {
         let mut x = 12345u64;
@@ -151,7 +218,7 @@ mod tests {
         let mut s = Faces::default();
         let mut plain: Vec<Face> = Vec::new();
         let mut oldest = 0;
-        for step in 0..20_000u32 {
+        for step in 0..60_000u32 {
             if rng() % 2 == 0 || oldest == plain.len() {
                 s.push(face(step));
                 plain.push(face(step));
@@ -163,13 +230,14 @@ mod tests {
                 } else {
                     oldest
                 };
-                // Every 40th face lives to the end, like a pass's faces on
-                // its part's walls.
-                if plain[id].alive && id % 40 != 0 {
+                // Every 40th face of the first half lives to the end, like
+                // a pass's faces on its part's walls.
+                let kept = |id: usize| id.is_multiple_of(40) && id < 8000;
+                if plain[id].alive && !kept(id) {
                     s.kill(id);
                     plain[id].alive = false;
                 }
-                while oldest < plain.len() && (!plain[oldest].alive || oldest % 40 == 0) {
+                while oldest < plain.len() && (!plain[oldest].alive || kept(oldest)) {
                     oldest += 1;
                 }
             }
@@ -181,6 +249,7 @@ mod tests {
                 assert_eq!((a.v, a.owner), (b.v, b.owner), "face {i}");
             }
         }
+        let (mut packed, mut gone) = (0, 0);
         for (c, (ch, &n)) in s.chunks.iter().zip(&s.live).enumerate() {
             let want = plain[c << BITS..]
                 .iter()
@@ -189,14 +258,23 @@ mod tests {
                 .count();
             assert_eq!(n as usize, want);
             let last = c + 1 == s.chunks.len();
-            assert_eq!(ch.is_none(), n <= SPARSE_AT && !last, "chunk {c}");
+            match ch {
+                Chunk::Full(_) => assert!(last || n > PACK_AT, "chunk {c}: {n} live"),
+                Chunk::Packed(p) => {
+                    packed += 1;
+                    assert!(!last && n > 0 && n <= PACK_AT, "chunk {c}: {n} live");
+                    // At most twice its live faces, and one slot per set bit.
+                    assert!(p.faces.len() < 2 * n as usize, "chunk {c}");
+                    let bits: u32 = p.mask.iter().map(|m| m.count_ones()).sum();
+                    assert_eq!(bits as usize, p.faces.len());
+                }
+                Chunk::Gone => {
+                    gone += 1;
+                    assert!(!last && n == 0, "chunk {c}");
+                }
+            }
         }
-        // The map holds the live faces of the freed chunks, and no more.
-        let in_freed = (0..plain.len())
-            .filter(|&i| plain[i].alive && s.chunks[i >> BITS].is_none())
-            .count();
-        assert_eq!(s.sparse.len(), in_freed);
-        assert!(in_freed > 0 && s.chunks.iter().any(|c| c.is_none()));
+        assert!(packed > 0 && gone > 0, "{packed} packed, {gone} gone");
         s[plain.iter().position(|f| f.alive).unwrap()].tries += 1;
     }
 }
