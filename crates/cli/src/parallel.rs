@@ -128,14 +128,20 @@ pub(crate) fn write_partitioned_share(
     for (r, st) in sum.parallel.iter().enumerate() {
         region_base[r + 1] = region_base[r] + st.pass_tets.iter().sum::<usize>() as i64;
     }
+    // The pieces with tets: each its index in `sum.pieces`, and its region.
+    let shown: Vec<(usize, usize)> = (0..sum.pieces.len())
+        .filter(|&i| !sum.pieces[i].tets.is_empty())
+        .map(|i| (i, i / n_held))
+        .collect();
+    let ids: Vec<usize> = shown
+        .iter()
+        .map(|&(i, r)| r * parts + held.start + i % n_held)
+        .collect();
     // Each piece's arrays are made as it is written, then dropped: a
     // process held a second copy of all its pieces here (its peak on
     // sphere_5e6 at 4 ranks).
-    let arrays = sum.pieces.iter().enumerate().filter_map(|(i, pc)| {
-        let (r, k) = (i / n_held, held.start + i % n_held);
-        if pc.tets.is_empty() {
-            return None;
-        }
+    let arrays = shown.iter().map(|&(i, r)| {
+        let (pc, k) = (&sum.pieces[i], held.start + i % n_held);
         let cell_base = region_base[r];
         let mut sharers = vec![0i32; pc.points.len()];
         for list in &pc.shared {
@@ -144,7 +150,7 @@ pub(crate) fn write_partitioned_share(
             }
         }
         let region = r as u32 + 1;
-        Some(Arrays {
+        Arrays {
             mesh: TetMesh {
                 points: pc.points.clone(),
                 tets: pc.tets.iter().map(|t| t.map(PointId::from_raw)).collect(),
@@ -161,12 +167,8 @@ pub(crate) fn write_partitioned_share(
             sharers,
             cell_gid: pc.tet_gid.iter().map(|&g| cell_base + g as i64).collect(),
             pass: pc.tet_pass.iter().map(|&p| p as i32).collect(),
-        })
+        }
     });
-    let ids: Vec<usize> = (sum.pieces.iter().enumerate())
-        .filter(|(_, pc)| !pc.tets.is_empty())
-        .map(|(i, _)| (i / n_held) * parts + held.start + i % n_held)
-        .collect();
     fn piece(a: &Arrays) -> Piece<'_> {
         Piece {
             mesh: &a.mesh,

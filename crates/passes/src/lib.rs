@@ -108,11 +108,10 @@ impl Default for ParOptions {
     }
 }
 
-impl ParOptions {
-    pub(crate) fn released(&self) {
-        if let Some(f) = self.release {
-            f();
-        }
+/// Runs the release hook of [`ParOptions::release`], if there is one.
+pub(crate) fn release(hook: Option<fn()>) {
+    if let Some(f) = hook {
+        f();
     }
 }
 
@@ -450,7 +449,7 @@ pub fn mesh_parallel_around<C: Comm>(
     let (loc, w, base) = split_ddg(&d, size, opts, np, &mut rec);
     // The DDG's build leaves its fronts' memory free in the allocator's
     // heaps; a process's peak comes later, in pass 1.
-    opts.released();
+    release(opts.release);
 
     let all: Vec<[u32; 3]>;
     let faces = if core.is_empty() {

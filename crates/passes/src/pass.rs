@@ -106,9 +106,7 @@ pub(crate) fn parallel_pass<C: Comm>(
         .map(|(i, (part, inbox))| {
             let made = front_call(inbox, (start + i) as u32, regions, size)
                 .map(|m| absorb_local(part, m, pass));
-            if let Some(f) = release {
-                f();
-            }
+            crate::release(release);
             made
         })
         .collect();

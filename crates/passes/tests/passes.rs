@@ -2,7 +2,7 @@ use parafront_comm::Threads;
 use parafront_front::{advance, Everywhere, FrontInput, FrontOptions, SizeMode};
 use parafront_geom::{tet_volume6, P3};
 use parafront_mesh::{PointId, TetMesh};
-use parafront_passes::{mesh_parallel, ParOptions, ParOutput, Partition};
+use parafront_passes::{mesh_parallel, ParOptions, ParOutput, Partition, PassError};
 use parafront_surface::{generate, Surface};
 
 /// Coordinates as bits: "the same mesh" means the same floats.
@@ -15,6 +15,16 @@ fn run(s: &Surface, h: f64, parts: usize) -> ParOutput {
 }
 
 fn run_with(s: &Surface, h: f64, parts: usize, partition: Partition) -> ParOutput {
+    let opts = ParOptions {
+        parts,
+        partition,
+        ..ParOptions::default()
+    };
+    run_opts(s, h, &opts).unwrap_or_else(|e| panic!("{parts} parts: {e}"))
+}
+
+/// The passes on `opts.parts` parts (threads backend) at uniform size `h`.
+fn run_opts(s: &Surface, h: f64, opts: &ParOptions) -> Result<ParOutput, PassError> {
     let field = move |_p: P3| h;
     let faces: Vec<[u32; 3]> = s.tris.iter().map(|t| [t[0], t[2], t[1]]).collect();
     let hs: Vec<f64> = s.mean_edge_lengths();
@@ -23,14 +33,9 @@ fn run_with(s: &Surface, h: f64, parts: usize, partition: Partition) -> ParOutpu
         &hs,
         &faces,
         &field,
-        &ParOptions {
-            parts,
-            partition,
-            ..ParOptions::default()
-        },
-        &Threads::new(parts),
+        opts,
+        &Threads::new(opts.parts),
     )
-    .unwrap_or_else(|e| panic!("{parts} parts: {e}"))
 }
 
 fn serial_tets(s: &Surface, h: f64) -> usize {
@@ -357,23 +362,13 @@ fn count_release() {
 #[test]
 fn the_release_hook_runs_between_fronts_and_changes_nothing() {
     let s = generate::icosphere([0.0; 3], 1.0, 3);
-    let field = move |_p: P3| 0.12;
-    let faces: Vec<[u32; 3]> = s.tris.iter().map(|t| [t[0], t[2], t[1]]).collect();
-    let hs: Vec<f64> = s.mean_edge_lengths();
     let go = |release: Option<fn()>| {
-        mesh_parallel(
-            &s.points,
-            &hs,
-            &faces,
-            &field,
-            &ParOptions {
-                parts: 4,
-                release,
-                ..ParOptions::default()
-            },
-            &Threads::new(4),
-        )
-        .unwrap()
+        let opts = ParOptions {
+            parts: 4,
+            release,
+            ..ParOptions::default()
+        };
+        run_opts(&s, 0.12, &opts).unwrap()
     };
     let plain = go(None);
     assert_eq!(RELEASED.load(std::sync::atomic::Ordering::Relaxed), 0);

@@ -150,7 +150,7 @@ impl Faces {
             Chunk::Packed(p) => {
                 Chunk::Packed(Box::new(Packed::new(p.offsets().zip(p.faces.iter()), n)))
             }
-            Chunk::Gone => Chunk::Gone,
+            Chunk::Gone => unreachable!("a live face's chunk is kept"),
         };
     }
 
