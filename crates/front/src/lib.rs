@@ -17,7 +17,7 @@ mod queue;
 
 pub use crate::core::{
     advance, FrontError, FrontInput, FrontOptions, FrontResult, FrontStats, Partial,
-    DEFAULT_FILL_AFTER, MAX_GROWTH_PER_TET,
+    DEFAULT_FILL_AFTER, MAX_GROWTH_PER_TET, RELEASE_FROM,
 };
 
 use std::sync::atomic::{AtomicU64, AtomicU8, Ordering};

@@ -254,3 +254,30 @@ fn a_first_stall_on_most_faces_is_filled_without_recovery() {
     assert!(stats[0].cavities_filled > 0, "{:?}", stats[0]);
     assert!(stats[1].recovery_rounds > 0, "{:?}", stats[1]);
 }
+
+/// `FrontOptions::release` runs once a large front has halved, and leaves
+/// the mesh as it was: a slab one cube thick, whose 81,000 faces start
+/// the front over [`RELEASE_FROM`] and close as its cubes fill.
+#[test]
+fn the_release_hook_runs_as_a_large_front_shrinks_and_changes_nothing() {
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    static CALLS: AtomicUsize = AtomicUsize::new(0);
+    fn count() {
+        CALLS.fetch_add(1, Ordering::Relaxed);
+    }
+    let s = generate::voxels([0.0; 3], 1.0, [200, 100, 1], |_, _, _| true);
+    assert!(s.tris.len() > 2 * RELEASE_FROM, "{}", s.tris.len());
+    let (plain, _) = fill(&s, 1.0);
+    let (hooked, _) = fill_with(
+        &s,
+        1.0,
+        &FrontOptions {
+            release: Some(count),
+            ..FrontOptions::default()
+        },
+    );
+    let calls = CALLS.load(Ordering::Relaxed);
+    assert!((1..=8).contains(&calls), "{calls} calls");
+    assert_eq!(plain.points, hooked.points);
+    assert_eq!(plain.tets, hooked.tets);
+}

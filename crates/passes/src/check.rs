@@ -50,6 +50,30 @@ pub struct PieceCheckError {
     pub message: String,
 }
 
+/// Faces a part's check sorts at once (16 bytes each): more go in bands
+/// of their smallest global id.
+const BAND_FACES: usize = 1 << 20;
+
+/// Ranges `[lo, hi)` of smallest ids, bucket `b` of `hist` holding the
+/// faces whose smallest id is in `[b << shift, (b + 1) << shift)`, each
+/// range with at most `band` faces unless one bucket has more; and the most
+/// faces in one range.
+fn bands(hist: &[usize], shift: u32, band: usize) -> (Vec<(u64, u64)>, usize) {
+    let (mut ranges, mut most) = (Vec::new(), 0);
+    let (mut lo, mut n) = (0u64, 0usize);
+    for (b, &c) in hist.iter().enumerate() {
+        let at = (b as u64) << shift;
+        if n > 0 && n + c > band {
+            ranges.push((lo, at));
+            most = most.max(n);
+            (lo, n) = (at, 0);
+        }
+        n += c;
+    }
+    ranges.push((lo, u64::MAX));
+    (ranges, most.max(n))
+}
+
 /// Checks the pieces this process holds, `pieces[i]` those of part
 /// `owned().start + i` (one per region), against the input triangles
 /// `tris` (the pieces' global ids) and six times the enclosed volume.
@@ -59,6 +83,17 @@ pub fn check_pieces<C: Comm>(
     pieces: &[Vec<&Piece>],
     tris: &[[u32; 3]],
     enclosed_vol6: f64,
+) -> Result<PieceCheck, PieceCheckError> {
+    check_in_bands(comm, pieces, tris, enclosed_vol6, BAND_FACES)
+}
+
+/// [`check_pieces`] sorting at most `band` faces of a part at once.
+fn check_in_bands<C: Comm>(
+    comm: &C,
+    pieces: &[Vec<&Piece>],
+    tris: &[[u32; 3]],
+    enclosed_vol6: f64,
+    band: usize,
 ) -> Result<PieceCheck, PieceCheckError> {
     let np = comm.parts() as u64;
     let input: FxHashSet<Key> = tris.iter().map(|&t| canon(t).0).collect();
@@ -88,7 +123,6 @@ pub fn check_pieces<C: Comm>(
                 covered: 0,
                 out: Vec::new(),
             };
-            let mut faces: Vec<(Key, bool)> = Vec::new();
             for pc in list {
                 for (t, tv) in pc.tets.iter().enumerate() {
                     let p = tv.map(|i| pc.points[i as usize]);
@@ -101,31 +135,60 @@ pub fn check_pieces<C: Comm>(
                         ));
                     }
                     l.vol6 += v6;
-                    for f in OUTWARD {
-                        faces.push(canon(f.map(|j| pc.gid[tv[j] as usize])));
-                    }
                 }
                 l.tets += pc.tets.len();
             }
-            faces.par_sort_unstable();
-            let mut i = 0;
-            while i < faces.len() {
-                let mut j = i + 1;
-                while j < faces.len() && faces[j].0 == faces[i].0 {
-                    j += 1;
-                }
-                match &faces[i..j] {
-                    [a] => l.out.push((home(&a.0), *a)),
-                    [a, b] if a.1 != b.1 => l.covered += input.contains(&a.0) as usize,
-                    _ => {
-                        l.fault.get_or_insert(format!(
-                            "part {part}: face {:?} is in {} tets of one piece, or in two on one side",
-                            faces[i].0,
-                            j - i
-                        ));
+            // The faces by their smallest global id, one band of ids at a
+            // time: all of a piece's faces at once were 64 bytes a tet,
+            // the peak of an MPI rank on sphere_5e6. Bands ascend, so the
+            // faces come out in the order one sort of them all gives.
+            let faces_of = |f: &mut dyn FnMut((Key, bool))| {
+                for pc in list {
+                    for tv in &pc.tets {
+                        for o in OUTWARD {
+                            f(canon(o.map(|j| pc.gid[tv[j] as usize])));
+                        }
                     }
                 }
-                i = j;
+            };
+            let n_faces = 4 * l.tets;
+            let (ranges, most) = if n_faces <= band {
+                (vec![(0, u64::MAX)], n_faces)
+            } else {
+                let max_id = list.iter().flat_map(|pc| pc.gid.iter()).copied().max();
+                let shift = (32 - max_id.unwrap_or(0).leading_zeros()).saturating_sub(12);
+                let mut hist = vec![0usize; 1 << 12];
+                faces_of(&mut |(k, _)| hist[(k[0] >> shift) as usize] += 1);
+                bands(&hist, shift, band)
+            };
+            let mut faces: Vec<(Key, bool)> = Vec::with_capacity(most);
+            for &(lo, hi) in &ranges {
+                faces.clear();
+                faces_of(&mut |(k, o)| {
+                    if (lo..hi).contains(&(k[0] as u64)) {
+                        faces.push((k, o));
+                    }
+                });
+                faces.par_sort_unstable();
+                let mut i = 0;
+                while i < faces.len() {
+                    let mut j = i + 1;
+                    while j < faces.len() && faces[j].0 == faces[i].0 {
+                        j += 1;
+                    }
+                    match &faces[i..j] {
+                        [a] => l.out.push((home(&a.0), *a)),
+                        [a, b] if a.1 != b.1 => l.covered += input.contains(&a.0) as usize,
+                        _ => {
+                            l.fault.get_or_insert(format!(
+                                "part {part}: face {:?} is in {} tets of one piece, or in two on one side",
+                                faces[i].0,
+                                j - i
+                            ));
+                        }
+                    }
+                    i = j;
+                }
             }
             l
         })
@@ -276,7 +339,27 @@ mod tests {
         vol6: f64,
     ) -> Result<PieceCheck, PieceCheckError> {
         let by_part: Vec<Vec<&Piece>> = pieces.iter().map(|p| vec![p]).collect();
-        check_pieces(&Threads::new(pieces.len()), &by_part, tris, vol6)
+        let comm = Threads::new(pieces.len());
+        let all = check_pieces(&comm, &by_part, tris, vol6);
+        // Sorted in bands of a few faces, the check says the same.
+        for band in [1, 7, 40] {
+            assert_eq!(check_in_bands(&comm, &by_part, tris, vol6, band), all);
+        }
+        all
+    }
+
+    #[test]
+    fn bands_cover_every_id_and_hold_at_most_a_band() {
+        let hist = [3, 0, 5, 1, 9, 2, 2];
+        let (r, most) = bands(&hist, 4, 6);
+        // [0,32): 3+0; [32,64): 5+1; [64,80): 9 (one bucket over); rest 4.
+        assert_eq!(r, vec![(0, 32), (32, 64), (64, 80), (80, u64::MAX)]);
+        assert_eq!(most, 9);
+        for w in r.windows(2) {
+            assert_eq!(w[0].1, w[1].0);
+        }
+        assert_eq!(bands(&hist, 4, 100), (vec![(0, u64::MAX)], 22));
+        assert_eq!(bands(&[0; 4], 0, 1), (vec![(0, u64::MAX)], 0));
     }
 
     #[test]

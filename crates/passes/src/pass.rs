@@ -104,7 +104,7 @@ pub(crate) fn parallel_pass<C: Comm>(
         .zip(inboxes)
         .enumerate()
         .map(|(i, (part, inbox))| {
-            let made = front_call(inbox, (start + i) as u32, regions, size)
+            let made = front_call(inbox, (start + i) as u32, regions, size, release)
                 .map(|m| absorb_local(part, m, pass));
             crate::release(release);
             made
@@ -138,6 +138,7 @@ pub(crate) fn front_call(
     k: u32,
     regions: &dyn Regions,
     size: Sizes<'_>,
+    release: Option<fn()>,
 ) -> Result<Made, (usize, FrontError)> {
     let t0 = Instant::now();
     let n_owned: usize = inbox.iter().map(|(_, b)| b.owned.len()).sum();
@@ -172,6 +173,7 @@ pub(crate) fn front_call(
         &FrontOptions {
             pass: true,
             max_growth: size.max_growth,
+            release,
             ..FrontOptions::default()
         },
     )

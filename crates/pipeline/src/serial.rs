@@ -70,6 +70,7 @@ pub(crate) fn serial_region(
                 fill_after: opts.fill_after,
                 fill_early: true,
                 hand_over,
+                release: opts.release_memory,
                 ..FrontOptions::default()
             },
         );

@@ -59,7 +59,17 @@ pub struct FrontOptions {
     /// the fill cannot close go on to recovery. Not in a parallel pass
     /// (§7), whose front is open.
     pub fill_at_stall: bool,
+    /// Called once the live front has shrunk to half its largest size
+    /// since the last call (from [`RELEASE_FROM`] faces): the caller hands
+    /// the memory of the faces and grid cells freed since back to the
+    /// system (the CLI: glibc's `malloc_trim`). It must not touch the
+    /// mesh; none by default.
+    pub release: Option<fn()>,
 }
+
+/// The live front, in faces, below which [`FrontOptions::release`] is not
+/// called: a smaller front frees too little to be worth a call.
+pub const RELEASE_FROM: usize = 1 << 15;
 
 impl Default for FrontOptions {
     fn default() -> Self {
@@ -78,6 +88,7 @@ impl Default for FrontOptions {
             fill_early: false,
             hand_over: false,
             fill_at_stall: true,
+            release: None,
         }
     }
 }

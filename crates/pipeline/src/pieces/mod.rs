@@ -31,9 +31,13 @@ fn key(p: parafront_geom::P3) -> Key {
     p.map(|x| (x + 0.0).to_bits())
 }
 
-/// One improved piece before its points are numbered again.
+/// One improved piece before its points are numbered again: its points
+/// and tets only. The improver's mesh also has each tet's neighbours and
+/// region, and room to grow; a process holds every piece it improved until
+/// the round ends (sphere_5e6 at `--size 0.021 --parts 8`: 14 MB a piece).
 struct Improved {
-    mesh: TetMesh,
+    points: Vec<parafront_geom::P3>,
+    tets: Vec<[u32; 4]>,
     /// Per point of `mesh`: its id in the piece before (a boundary point,
     /// which improvement never moves), or none (the piece's own).
     was: Vec<Option<u32>>,
@@ -214,7 +218,7 @@ fn improve_round<C: Comm>(
                     .map(|r| {
                         let d = &done[r * held + i];
                         let own = d.was.iter().filter(|w| w.is_none()).count() as u32;
-                        (own, d.mesh.tets.len() as u32)
+                        (own, d.tets.len() as u32)
                     })
                     .collect()
             })
@@ -243,8 +247,8 @@ fn improve_round<C: Comm>(
         }
     }
     for (pc, d) in pieces.iter_mut().zip(done) {
-        pc.points = d.mesh.points;
-        pc.tets = d.mesh.tets.iter().map(|t| t.map(|p| p.raw())).collect();
+        pc.points = d.points;
+        pc.tets = d.tets;
         // Improvement made these tets; no pass did.
         pc.tet_pass = vec![0; pc.tets.len()];
     }
@@ -317,7 +321,14 @@ fn improve_piece(
         .iter()
         .map(|&p| by_key.get(&key(p)).copied())
         .collect();
-    Ok((Improved { mesh, was }, st))
+    let TetMesh {
+        mut points, tets, ..
+    } = mesh;
+    points.shrink_to_fit();
+    // In place (the same layout), then cut to its length.
+    let mut tets: Vec<[u32; 4]> = tets.into_iter().map(|t| t.map(|p| p.raw())).collect();
+    tets.shrink_to_fit();
+    Ok((Improved { points, tets, was }, st))
 }
 
 /// The piece with the balls of its `free` points improved: those tets cut
@@ -421,7 +432,7 @@ fn renumber(pc: &mut Piece, d: &Improved, kept: &[u32], own_base: u32, tet_base:
     }
     pc.gid = gid;
     pc.owner = owner;
-    pc.tet_gid = (tet_base..tet_base + d.mesh.tets.len() as u32).collect();
+    pc.tet_gid = (tet_base..tet_base + d.tets.len() as u32).collect();
 }
 
 /// Adds one piece's run to `a` (separate runs: every count adds).
