@@ -249,8 +249,29 @@ pub(super) fn absorb_local(part: &mut Part, m: Made, pass: u8) -> Absorbed {
     part.size.reserve_exact(n_new);
     part.gid.reserve_exact(n_new);
     part.index.reserve(n_new);
+    let ok = |i: u32| (i as usize) >= n_in || m.input_ok[i as usize];
+    let kept = |f: &[u32; 3]| f.iter().all(|&i| ok(i));
+    // Only the input points a tet or a kept face names join the part: the
+    // context faces' other points stay with their holders (at 64 parts,
+    // the parts' copies of them were a third of sphere_1e6's peak).
+    let mut named = vec![false; n_in];
+    for &i in r.tets.iter().flatten() {
+        if let Some(x) = named.get_mut(i as usize) {
+            *x = true;
+        }
+    }
+    for f in r.front.iter().filter(|f| kept(f)) {
+        for &i in f {
+            if let Some(x) = named.get_mut(i as usize) {
+                *x = true;
+            }
+        }
+    }
     let mut map: Vec<u32> = (0..n_in)
         .map(|i| {
+            if !named[i] {
+                return u32::MAX;
+            }
             part.local(Rec {
                 gid: m.input_gid[i],
                 p: r.points[i],
@@ -258,6 +279,7 @@ pub(super) fn absorb_local(part: &mut Part, m: Made, pass: u8) -> Absorbed {
             })
         })
         .collect();
+    drop(named);
     // The new points are new to the part: pushed in order, indexed later.
     let first_new = part.pts.len() as u32;
     for i in n_in..r.points.len() {
@@ -266,10 +288,9 @@ pub(super) fn absorb_local(part: &mut Part, m: Made, pass: u8) -> Absorbed {
         part.size.push(r.point_size[i]);
         part.gid.push(u32::MAX);
     }
-    let ok = |i: u32| (i as usize) >= n_in || m.input_ok[i as usize];
     let mut stuck = Vec::new();
     for (j, f) in r.front.iter().enumerate() {
-        if f.iter().all(|&i| ok(i)) {
+        if kept(f) {
             part.front.push(f.map(|i| map[i as usize]));
             if m.stuck.get(j) == Some(&true) {
                 stuck.extend(f.map(|i| map[i as usize]));
@@ -332,4 +353,46 @@ pub(super) fn is_stuck(
     let dm = (dist(m, p[0]) + dist(m, p[1]) + dist(m, p[2])) / 3.0;
     let alpha = (h * h - dm * dm).max(0.25 * dm * dm).sqrt();
     filter.point_ok(add(m, scale(nrm, alpha)))
+}
+
+#[cfg(test)]
+mod absorb_tests {
+    use super::*;
+    use parafront_front::{FrontResult, FrontStats};
+
+    /// A front call's input points that no tet and no kept face names (its
+    /// context faces' far corners) stay out of the part; the rest keep
+    /// their order, and the new points follow them.
+    #[test]
+    fn only_the_points_a_tet_or_a_kept_face_names_join_the_part() {
+        let p = |i: u32| [i as f64, (i * i) as f64, 1.0];
+        // Inputs 0..6 (global ids 100..106), input 5 outside the part; new
+        // point 6. Tet on 0, 2, 3, 6; kept face 3, 4, 6; face 1, 5, 6 is
+        // dropped (5 is outside), so 1 and 5 are named by nothing kept.
+        let res = FrontResult {
+            points: (0..7).map(p).collect(),
+            point_size: vec![0.5; 7],
+            tets: vec![[0, 2, 3, 6]],
+            neigh: Vec::new(),
+            front: vec![[3, 4, 6], [1, 5, 6]],
+            stats: FrontStats::default(),
+        };
+        let made = Made {
+            res: Some(res),
+            input_gid: (100..106).collect(),
+            input_ok: vec![true, true, true, true, true, false],
+            stuck: vec![true, false],
+            seconds: 0.0,
+        };
+        let mut part = Part::default();
+        let a = absorb_local(&mut part, made, 2);
+        absorb_finish(&mut part, &a, 500);
+        assert_eq!(part.gid, vec![100, 102, 103, 104, 500]);
+        assert_eq!(part.pts, [0, 2, 3, 4, 6].map(p).to_vec());
+        assert_eq!(part.tets, vec![[0, 1, 2, 4]]);
+        assert_eq!(part.front, vec![[2, 3, 4]]);
+        assert_eq!(part.stuck, vec![103, 104, 500]);
+        assert_eq!(part.tet_pass, vec![2]);
+        part.check().expect("a sound part");
+    }
 }
