@@ -4,6 +4,12 @@
 //! and the front each DDG tet is left with.
 use super::*;
 
+/// Parts per thread in one round of a pass's messages.
+const ROUND_PER_THREAD: usize = 4;
+
+/// A part's front call taken into it, or its failure.
+type Taken = Result<Absorbed, (usize, FrontError)>;
+
 /// One parallel pass on partition `part_of`: send each front face to the
 /// part that owns its three points, and a copy to every part whose region
 /// box it meets (so that each part knows every face bounding its region);
@@ -34,15 +40,25 @@ pub(crate) fn parallel_pass<C: Comm>(
         })
         .collect();
 
-    // Each holder sorts its faces out: one batch per destination.
-    let outboxes: Vec<Vec<(u32, FaceBatch)>> = parts
-        .par_iter_mut()
+    // Each holder routes its faces once: (destination, face, owned
+    // there), by destination, each in face order (a stable sort). The
+    // faces it keeps (no one part owns them) stay its front; the routed
+    // ones wait in `olds` until every round has sent them.
+    let mut olds: Vec<Vec<[u32; 3]>> = Vec::with_capacity(parts.len());
+    let routes: Vec<Vec<(u32, u32, bool)>> = parts
+        .iter_mut()
         .map(|part| {
+            olds.push(std::mem::take(&mut part.front));
+            Vec::new()
+        })
+        .collect();
+    let routes: Vec<Vec<(u32, u32, bool)>> = parts
+        .par_iter_mut()
+        .zip(&olds)
+        .zip(routes)
+        .map(|((part, old), mut to)| {
             let mut owner: Vec<Option<Option<u32>>> = vec![None; part.pts.len()];
-            // (destination, face, owned there), in face order.
-            let mut to: Vec<(u32, u32, bool)> = Vec::new();
-            let mut keep = Vec::new();
-            for (fi, &f) in part.front.iter().enumerate() {
+            for (fi, &f) in old.iter().enumerate() {
                 let o = f.map(|i| {
                     *owner[i as usize].get_or_insert_with(|| regions.owner(part.pts[i as usize]))
                 });
@@ -59,56 +75,53 @@ pub(crate) fn parallel_pass<C: Comm>(
                 }
                 match own {
                     Some(k) => to.push((k, fi as u32, true)),
-                    None => keep.push(f),
+                    None => part.front.push(f),
                 }
             }
-            drop(owner);
-            // By destination, each in face order (a stable sort).
             to.sort_by_key(|x| x.0);
-            // Per point, its index in the batch being built.
-            let mut at = vec![u32::MAX; part.pts.len()];
-            let mut ids: Vec<u32> = Vec::new();
-            let mut out = Vec::new();
-            for group in to.chunk_by(|a, b| a.0 == b.0) {
-                let mut b = FaceBatch::default();
-                for &(_, fi, owned) in group {
-                    let v = part.front[fi as usize].map(|i| {
-                        if at[i as usize] == u32::MAX {
-                            at[i as usize] = ids.len() as u32;
-                            ids.push(i);
-                        }
-                        at[i as usize]
-                    });
-                    if owned {
-                        b.owned.push(v);
-                    } else {
-                        b.context.push(v);
-                    }
-                }
-                b.points = ids.iter().map(|&i| part.rec(i)).collect();
-                for i in ids.drain(..) {
-                    at[i as usize] = u32::MAX;
-                }
-                out.push((group[0].0, b));
-            }
-            part.front = keep;
-            out
+            to
         })
         .collect();
-    let inboxes = comm.exchange(outboxes);
 
-    // Every part meshes inside its region, and takes its result in at
-    // once.
-    let made: Vec<Result<Absorbed, (usize, FrontError)>> = parts
-        .par_iter_mut()
-        .zip(inboxes)
-        .enumerate()
-        .map(|(i, (part, inbox))| {
-            let made = front_call(inbox, (start + i) as u32, regions, size, release)
-                .map(|m| absorb_local(part, m, pass));
-            crate::release(release);
-            made
-        })
+    // The messages go in rounds, each to the parts that then advance
+    // together: a process holds one round's inboxes, not every part's. At
+    // 32 parts on one process, pass 2's inboxes took sphere_5e6 from 124
+    // to 168 MiB. A part's inbox is the same in any round, so is its mesh.
+    // Rounds of one part per thread were 3-7 % slower on 2 threads
+    // (sphere_1e6, torus_1e6: the threads wait at each round's end).
+    let width = ROUND_PER_THREAD * rayon::current_num_threads().max(1);
+    let round_of: Vec<u32> =
+        comm.all_gather((0..parts.len()).map(|i| (i / width) as u32).collect());
+    let rounds = round_of.iter().max().map_or(0, |&r| r as usize + 1);
+    let mut made: Vec<Option<Taken>> = (0..parts.len()).map(|_| None).collect();
+    for r in 0..rounds as u32 {
+        let outboxes: Vec<Vec<(u32, FaceBatch)>> = parts
+            .par_iter()
+            .zip(&olds)
+            .zip(&routes)
+            .map(|((part, old), to)| batches(part, old, to, |q| round_of[q as usize] == r))
+            .collect();
+        let inboxes = comm.exchange(outboxes);
+        let done: Vec<(usize, Taken)> = parts
+            .par_iter_mut()
+            .zip(inboxes)
+            .enumerate()
+            .filter(|(i, _)| round_of[start + i] == r)
+            .map(|(i, (part, inbox))| {
+                let m = front_call(inbox, (start + i) as u32, regions, size, release)
+                    .map(|m| absorb_local(part, m, pass));
+                crate::release(release);
+                (i, m)
+            })
+            .collect();
+        for (i, m) in done {
+            made[i] = Some(m);
+        }
+    }
+    drop((olds, routes));
+    let made: Vec<Taken> = made
+        .into_iter()
+        .map(|m| m.expect("every owned part has a round"))
         .collect();
     let made = crate::agree(comm, pass, made)?;
 
@@ -129,6 +142,50 @@ pub(crate) fn parallel_pass<C: Comm>(
         .for_each(|((part, a), &b)| absorb_finish(part, a, b));
     let tets: Vec<usize> = made.iter().map(|a| a.tets).collect();
     Ok((comm.all_gather(tets), secs))
+}
+
+/// A holder's batches for the destinations `to_round` picks: one per
+/// destination, its points once each, then its owned and context faces
+/// (indices into them), each list in the holder's face order.
+fn batches(
+    part: &Part,
+    old: &[[u32; 3]],
+    to: &[(u32, u32, bool)],
+    to_round: impl Fn(u32) -> bool,
+) -> Vec<(u32, FaceBatch)> {
+    // Per point, its index in the batch being built.
+    let mut at: Vec<u32> = Vec::new();
+    let mut ids: Vec<u32> = Vec::new();
+    let mut out = Vec::new();
+    for group in to.chunk_by(|a, b| a.0 == b.0) {
+        if !to_round(group[0].0) {
+            continue;
+        }
+        if at.is_empty() {
+            at = vec![u32::MAX; part.pts.len()];
+        }
+        let mut b = FaceBatch::default();
+        for &(_, fi, owned) in group {
+            let v = old[fi as usize].map(|i| {
+                if at[i as usize] == u32::MAX {
+                    at[i as usize] = ids.len() as u32;
+                    ids.push(i);
+                }
+                at[i as usize]
+            });
+            if owned {
+                b.owned.push(v);
+            } else {
+                b.context.push(v);
+            }
+        }
+        b.points = ids.iter().map(|&i| part.rec(i)).collect();
+        for i in ids.drain(..) {
+            at[i as usize] = u32::MAX;
+        }
+        out.push((group[0].0, b));
+    }
+    out
 }
 
 /// Builds one part's front from its inbox (owned faces first, then the

@@ -381,3 +381,25 @@ fn the_release_hook_runs_between_fronts_and_changes_nothing() {
     assert_eq!(bits(&plain.points), bits(&hooked.points));
     check(&s, &hooked);
 }
+
+/// A pass's messages go in rounds of `4 x threads` parts; the mesh is the
+/// same whether 24 parts take one round or six.
+#[test]
+fn the_message_rounds_leave_the_mesh_as_it_was() {
+    let s = generate::icosphere([0.0; 3], 1.0, 3);
+    let opts = ParOptions {
+        parts: 24,
+        ..ParOptions::default()
+    };
+    let on = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| run_opts(&s, 0.12, &opts).unwrap())
+    };
+    let (six, one) = (on(1), on(8));
+    assert_eq!(six.tets, one.tets);
+    assert_eq!(bits(&six.points), bits(&one.points));
+    check(&s, &six);
+}
