@@ -44,19 +44,15 @@ pub(crate) fn parallel_pass<C: Comm>(
     // there), by destination, each in face order (a stable sort). The
     // faces it keeps (no one part owns them) stay its front; the routed
     // ones wait in `olds` until every round has sent them.
-    let mut olds: Vec<Vec<[u32; 3]>> = Vec::with_capacity(parts.len());
-    let routes: Vec<Vec<(u32, u32, bool)>> = parts
+    let olds: Vec<Vec<[u32; 3]>> = parts
         .iter_mut()
-        .map(|part| {
-            olds.push(std::mem::take(&mut part.front));
-            Vec::new()
-        })
+        .map(|part| std::mem::take(&mut part.front))
         .collect();
     let routes: Vec<Vec<(u32, u32, bool)>> = parts
         .par_iter_mut()
         .zip(&olds)
-        .zip(routes)
-        .map(|((part, old), mut to)| {
+        .map(|(part, old)| {
+            let mut to = Vec::new();
             let mut owner: Vec<Option<Option<u32>>> = vec![None; part.pts.len()];
             for (fi, &f) in old.iter().enumerate() {
                 let o = f.map(|i| {

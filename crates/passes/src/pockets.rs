@@ -255,16 +255,10 @@ pub(super) fn absorb_local(part: &mut Part, m: Made, pass: u8) -> Absorbed {
     // context faces' other points stay with their holders (at 64 parts,
     // the parts' copies of them were a third of sphere_1e6's peak).
     let mut named = vec![false; n_in];
-    for &i in r.tets.iter().flatten() {
+    let kept_faces = r.front.iter().filter(|f| kept(f));
+    for &i in r.tets.iter().flatten().chain(kept_faces.flatten()) {
         if let Some(x) = named.get_mut(i as usize) {
             *x = true;
-        }
-    }
-    for f in r.front.iter().filter(|f| kept(f)) {
-        for &i in f {
-            if let Some(x) = named.get_mut(i as usize) {
-                *x = true;
-            }
         }
     }
     let mut map: Vec<u32> = (0..n_in)

@@ -38,7 +38,7 @@ fn key(p: parafront_geom::P3) -> Key {
 struct Improved {
     points: Vec<parafront_geom::P3>,
     tets: Vec<[u32; 4]>,
-    /// Per point of `mesh`: its id in the piece before (a boundary point,
+    /// Per point of `points`: its id in the piece before (a boundary point,
     /// which improvement never moves), or none (the piece's own).
     was: Vec<Option<u32>>,
 }
