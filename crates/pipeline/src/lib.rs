@@ -504,14 +504,15 @@ fn mesh_sized<C: Comm>(
 
     opts.note_phase(parafront_front::Phase::Checking);
     let t0 = Instant::now();
-    // Improvement keeps the adjacency up to date; the check below compares
-    // every entry with its own face table, so a complete one is not built
-    // again (0.12 of 0.30 s at sphere_1e6 on one thread).
-    if opts.no_check || mesh.neigh.len() != 4 * mesh.tets.len() {
+    // The check pairs the faces in its own table (three tets on a face, two
+    // on one side), and compares the adjacency with it where improvement
+    // kept one; where a lattice or --optimize 0 left none, none is built
+    // for it (0.3 of 0.6 s on sphere_1e6 at --size 0.037). Without the check,
+    // the adjacency's build is the conformity test.
+    if opts.no_check {
         mesh.build_adjacency()
             .map_err(|source| MeshError::Adjacency { source })?;
-    }
-    if !opts.no_check {
+    } else {
         mesh.check_against_surface(&s.tris)?;
         // Exactly positive is not enough: a solver computes volumes in
         // floating point, and so does meshcheck.py.
