@@ -89,7 +89,7 @@ pub(crate) fn parallel_pass<C: Comm>(
     let round_of: Vec<u32> =
         comm.all_gather((0..parts.len()).map(|i| (i / width) as u32).collect());
     let rounds = round_of.iter().max().map_or(0, |&r| r as usize + 1);
-    let mut made: Vec<Option<Taken>> = (0..parts.len()).map(|_| None).collect();
+    let mut made: Vec<(usize, Taken)> = Vec::with_capacity(parts.len());
     for r in 0..rounds as u32 {
         let outboxes: Vec<Vec<(u32, FaceBatch)>> = parts
             .par_iter()
@@ -98,27 +98,24 @@ pub(crate) fn parallel_pass<C: Comm>(
             .map(|((part, old), to)| batches(part, old, to, |q| round_of[q as usize] == r))
             .collect();
         let inboxes = comm.exchange(outboxes);
-        let done: Vec<(usize, Taken)> = parts
-            .par_iter_mut()
-            .zip(inboxes)
-            .enumerate()
-            .filter(|(i, _)| round_of[start + i] == r)
-            .map(|(i, (part, inbox))| {
-                let m = front_call(inbox, (start + i) as u32, regions, size, release)
-                    .map(|m| absorb_local(part, m, pass));
-                crate::release(release);
-                (i, m)
-            })
-            .collect();
-        for (i, m) in done {
-            made[i] = Some(m);
-        }
+        made.par_extend(
+            parts
+                .par_iter_mut()
+                .zip(inboxes)
+                .enumerate()
+                .filter(|(i, _)| round_of[start + i] == r)
+                .map(|(i, (part, inbox))| {
+                    let m = front_call(inbox, (start + i) as u32, regions, size, release)
+                        .map(|m| absorb_local(part, m, pass));
+                    crate::release(release);
+                    (i, m)
+                }),
+        );
     }
     drop((olds, routes));
-    let made: Vec<Taken> = made
-        .into_iter()
-        .map(|m| m.expect("every owned part has a round"))
-        .collect();
+    // In part order (each part was in exactly one round).
+    made.sort_unstable_by_key(|&(i, _)| i);
+    let made: Vec<Taken> = made.into_iter().map(|(_, m)| m).collect();
     let made = crate::agree(comm, pass, made)?;
 
     // Global ids for the new points: an all-gather of the counts.
