@@ -585,6 +585,12 @@ pub(crate) fn run_mesh_on<C: Comm>(
         }
     };
     if pieces_out {
+        // Parts left to the estimate were made in this one process (the
+        // pipeline refuses them over several), on a comm of their own.
+        if let Some((parts, _)) = sum.auto_parts {
+            let own = parafront_comm::Threads::new(parts);
+            return write_pieces(out, &mut sum, &wopts, &own, lead);
+        }
         return write_pieces(out, &mut sum, &wopts, comm, lead);
     }
     let t0 = Instant::now();

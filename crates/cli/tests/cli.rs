@@ -464,6 +464,38 @@ fn a_pvtu_output_keeps_the_pieces() {
     assert_eq!(parafront_io::read_mesh(&vol).unwrap().tets.len(), said0);
 }
 
+/// `-o x.pvtu` with the parts left to the estimate: the demo, small
+/// enough for the serial front, gets two parts (pieces need parts), and
+/// the pieces are those of `--parts 2`, byte for byte, a valid mesh of
+/// the surface once merged.
+#[test]
+fn a_pvtu_output_with_auto_parts_gets_two_at_least() {
+    let demo = parafront_surface::generate::demo_part();
+    let pv = tmp("auto_pieces.pvtu");
+    let o = bin().args(["demo", "-o"]).arg(&pv).output().unwrap();
+    let text = String::from_utf8_lossy(&o.stdout).to_string();
+    assert!(
+        o.status.success(),
+        "{text}{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(text.contains("parts (auto): 2 parts"), "{text}");
+    let given = tmp("given_pieces.pvtu");
+    let (said, _, m) = demo_pieces(&demo, 2, &[], &given);
+    assert_eq!(tets_said(&text), said);
+    m.check_against_surface(&demo.tris).unwrap();
+    let mut written = 0;
+    for k in 0..4 {
+        let a = pv.with_file_name(format!("auto_pieces_{k}.vtu"));
+        let b = given.with_file_name(format!("given_pieces_{k}.vtu"));
+        let (a, b) = (std::fs::read(&a).ok(), std::fs::read(&b).ok());
+        assert_eq!(a, b, "piece {k}");
+        written += usize::from(a.is_some());
+    }
+    // Two regions on two parts (a part may hold none of the small one).
+    assert!(written > 2, "{written} pieces");
+}
+
 /// The pieces' improvement reaches across their cuts: a tet under the
 /// lift's floor of 20° that the second round left near a cut goes, with
 /// the tets around it, into one piece, and a third round lifts it. At 4

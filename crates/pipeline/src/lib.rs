@@ -352,7 +352,8 @@ fn mesh_surface_here<C: Comm>(
     let opts = if opts.gather {
         opts
     } else {
-        if opts.parts < 2 {
+        // Parts left to the estimate are two at least (below).
+        if opts.parts != AUTO_PARTS && opts.parts < 2 {
             return Err(MeshError::Partitioned(
                 "it needs parts > 1 (--parts 2 or more)".into(),
             ));
@@ -415,7 +416,12 @@ fn mesh_surface_here<C: Comm>(
             return Err(MeshError::AutoPartsPerProcess);
         }
         let estimate = estimate_for_parts(s, &sizing, opts.part_tets);
-        let parts = auto_parts(estimate, opts.part_tets);
+        // Pieces need parts: a small job gets two rather than the serial
+        // front (which makes no pieces).
+        let parts = match auto_parts(estimate, opts.part_tets) {
+            1 if !opts.gather => 2,
+            p => p,
+        };
         tracing::debug!(estimate, parts, "parts from the estimated tet count");
         sum.auto_parts = Some((parts, estimate));
         Some(parts)
