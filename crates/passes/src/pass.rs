@@ -4,8 +4,15 @@
 //! and the front each DDG tet is left with.
 use super::*;
 
-/// Parts per thread in one round of a pass's messages.
+/// Parts per thread in one round of a pass's messages, on one process.
 const ROUND_PER_THREAD: usize = 4;
+
+/// The same over several processes (MPI), where memory per process is
+/// the point: a rank then holds one part's inbox per thread. sphere_5e6 at
+/// `--size 0.021 --parts 32`, 4 ranks of 1 thread: rank peaks 166-176 ->
+/// 132-137 MiB, in the same time (the ranks wait for each other at every
+/// exchange anyway).
+const ROUND_PER_THREAD_MPI: usize = 1;
 
 /// A part's front call taken into it, or its failure.
 type Taken = Result<Absorbed, (usize, FrontError)>;
@@ -85,7 +92,12 @@ pub(crate) fn parallel_pass<C: Comm>(
     // to 168 MiB. A part's inbox is the same in any round, so is its mesh.
     // Rounds of one part per thread were 3-7 % slower on 2 threads
     // (sphere_1e6, torus_1e6: the threads wait at each round's end).
-    let width = ROUND_PER_THREAD * rayon::current_num_threads().max(1);
+    let per_thread = if comm.owned().len() < np {
+        ROUND_PER_THREAD_MPI
+    } else {
+        ROUND_PER_THREAD
+    };
+    let width = per_thread * rayon::current_num_threads().max(1);
     let round_of: Vec<u32> =
         comm.all_gather((0..parts.len()).map(|i| (i / width) as u32).collect());
     let rounds = round_of.iter().max().map_or(0, |&r| r as usize + 1);
