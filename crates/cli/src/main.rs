@@ -201,7 +201,8 @@ struct MeshArgs {
     /// of --parts) leaves the interior, where the size field is nearly
     /// uniform, to a BCC lattice of near-ideal tets and meshes only around
     /// it. auto: when the size field has a largest size (--size or
-    /// --hmax); on; off. --pvtu turns it off (its tets are in no piece)
+    /// --hmax); on; off. --pvtu turns it off (the merged run's tets are in no
+    /// piece); -o x.pvtu only with on, which puts its tets into the pieces
     #[arg(long, value_name = "MODE", default_value = "auto")]
     lattice: parafront_pipeline::LatticeMode,
     /// With --parts > 1: a region less deep than this many mean surface

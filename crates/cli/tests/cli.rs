@@ -464,6 +464,49 @@ fn a_pvtu_output_keeps_the_pieces() {
     assert_eq!(parafront_io::read_mesh(&vol).unwrap().tets.len(), said0);
 }
 
+/// `-o x.pvtu` with a lattice core (§2, a size bound and `--lattice on`;
+/// by default pieces have none): its tets go into the pieces with the
+/// fronts'. Merged, the pieces are a valid mesh of the surface with the
+/// summary's tets; unimproved, they are the gathered run's tets.
+#[test]
+fn a_pvtu_output_holds_the_lattice() {
+    let demo = parafront_surface::generate::demo_part();
+    let pv = tmp("lattice_pieces.pvtu");
+    let on = ["--size", "0.8", "--lattice", "on"];
+    let (plain, _, _) = demo_pieces(&demo, 4, &on[..2], &tmp("no_lattice.pvtu"));
+    let (said, text, m) = demo_pieces(&demo, 4, &on, &pv);
+    assert_ne!(plain, said);
+    let lattice: usize = text
+        .split("lattice: ")
+        .nth(1)
+        .and_then(|t| t.split(' ').next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("no lattice: {text}"));
+    assert!(lattice > 1000 && lattice < said, "{text}");
+    assert_eq!(m.tets.len(), said);
+    m.check_against_surface(&demo.tris).unwrap();
+    let pv0 = tmp("lattice_pieces0.pvtu");
+    let (said0, _, m0) = demo_pieces(&demo, 4, &[&on[..], &["--optimize", "0"]].concat(), &pv0);
+    m0.check_against_surface(&demo.tris).unwrap();
+    let vol = tmp("lattice_merged.vtu");
+    let o = bin()
+        .args([
+            "demo",
+            "--parts",
+            "4",
+            "--size",
+            "0.8",
+            "--optimize",
+            "0",
+            "-o",
+        ])
+        .arg(&vol)
+        .output()
+        .unwrap();
+    assert!(o.status.success());
+    assert_eq!(parafront_io::read_mesh(&vol).unwrap().tets.len(), said0);
+}
+
 /// `-o x.pvtu` with the parts left to the estimate: the demo, small
 /// enough for the serial front, gets two parts (pieces need parts), and
 /// the pieces are those of `--parts 2`, byte for byte, a valid mesh of

@@ -143,22 +143,26 @@ fn every_rank_writes_its_pieces_of_a_pvtu() {
         eprintln!("skipping: mpirun not found");
         return;
     }
+    pieces_match_threads("pvtu", &["demo", "--parts", "8", "--optimize", "0"]);
+    // A lattice core (§2) whose tets go into the pieces, improved with its
+    // inner points frozen.
+    let lattice = ["demo", "--parts", "8", "--size", "0.8", "--lattice", "on"];
+    pieces_match_threads("pvtu_lattice", &lattice);
+}
+
+/// `args` plus `-o x.pvtu` on the threads backend, then on 2 and 4 ranks:
+/// the index names the demo's pieces (2 regions x 8 parts, less any empty
+/// one), which hold the summary's tets together, and every file is the
+/// threads run's, byte for byte.
+fn pieces_match_threads(tag: &str, args: &[&str]) {
     let limit = Duration::from_secs(300);
     let dir = |tag: &str| {
         let d = tmp(tag);
         std::fs::create_dir_all(&d).unwrap();
         d
     };
-    let args = [
-        "demo",
-        "--parts",
-        "8",
-        "--optimize",
-        "0",
-        "--no-compress",
-        "-o",
-    ];
-    let one = dir("pvtu_threads").join("demo.pvtu");
+    let args = [args, &["--no-compress", "-o"]].concat();
+    let one = dir(&format!("{tag}_threads")).join("demo.pvtu");
     let base = run(0, &[&args[..], &[one.to_str().unwrap()]].concat(), limit);
     assert!(base.ok, "{}", base.err);
     let n = tets_said(&base.out);
@@ -177,8 +181,6 @@ fn every_rank_writes_its_pieces_of_a_pvtu() {
         v
     };
     let want = files(&one);
-    // The index and the pieces it names (2 regions x 8 parts, less any
-    // empty one); together the summary's tets.
     let index = std::fs::read_to_string(&one).unwrap();
     let named = index.matches("<Piece Source=").count();
     assert!(named > 8 && named <= 16, "{index}");
@@ -191,7 +193,7 @@ fn every_rank_writes_its_pieces_of_a_pvtu() {
     assert!(sizes.iter().all(|&s| s > 0), "{sizes:?}");
     assert_eq!(sizes.iter().sum::<usize>(), n);
     for ranks in [2, 4] {
-        let many = dir(&format!("pvtu_{ranks}")).join("demo.pvtu");
+        let many = dir(&format!("{tag}_{ranks}")).join("demo.pvtu");
         let r = run(
             ranks,
             &[&args[..], &[many.to_str().unwrap()]].concat(),
@@ -205,7 +207,7 @@ fn every_rank_writes_its_pieces_of_a_pvtu() {
         for (a, b) in want.iter().zip(&got) {
             assert!(
                 a == b,
-                "{ranks} ranks: {} differs from the threads run's",
+                "{tag}, {ranks} ranks: {} differs from the threads run's",
                 b.0
             );
         }

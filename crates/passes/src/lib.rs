@@ -406,7 +406,7 @@ pub fn mesh_parallel<C: Comm>(
     opts: &ParOptions,
     comm: &C,
 ) -> Result<ParOutput, PassError> {
-    mesh_parallel_around(points, point_size, faces, &[], size, opts, comm)
+    mesh_parallel_around(points, point_size, faces, (&[], &[]), size, opts, comm)
 }
 
 /// [`mesh_parallel`] around a filled core: `core` are the outer faces of
@@ -415,12 +415,15 @@ pub fn mesh_parallel<C: Comm>(
 /// points that follow the surface's in `points`. The DDG and its partition
 /// cover the region as `faces` bound it, the fronts start from both, and
 /// no part is seeded (a part with no face lies inside the core). The
-/// output holds every point of `points` in order.
+/// output holds every point of `points` in order. The core's tets
+/// (`core_tets`: ids into `points`, a list for each part held, possibly
+/// none) go into the pieces with the fronts', pass 0; a caller that adds
+/// them to a merged mesh itself gives none.
 pub fn mesh_parallel_around<C: Comm>(
     points: &[P3],
     point_size: &[f64],
     faces: &[[u32; 3]],
-    core: &[[u32; 3]],
+    (core, core_tets): (&[[u32; 3]], &[Vec<[u32; 4]>]),
     size: &(dyn Fn(P3) -> f64 + Sync),
     opts: &ParOptions,
     comm: &C,
@@ -510,6 +513,7 @@ pub fn mesh_parallel_around<C: Comm>(
 
     // §8 step 4.
     let t0 = Instant::now();
+    part::add_core_tets(&mut parts, (points, point_size), core_tets);
     let out = redistribute::run(parts, comm, &loc, &on.base, points, next_gid, opts)?;
     let held = comm.all_gather(out.pieces.iter().map(|p| p.tets.len()).collect());
     let pass_tets = comm.all_reduce(
@@ -517,8 +521,11 @@ pub fn mesh_parallel_around<C: Comm>(
             .iter()
             .map(|pc| {
                 let mut n = [0usize; 4];
+                // The core's tets (pass 0) are no pass's.
                 for &p in &pc.tet_pass {
-                    n[p as usize - 1] += 1;
+                    if let Some(x) = (p as usize).checked_sub(1).and_then(|i| n.get_mut(i)) {
+                        *x += 1;
+                    }
                 }
                 n
             })

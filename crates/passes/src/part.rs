@@ -107,6 +107,32 @@ pub(crate) fn seed_parts(
     parts
 }
 
+/// §2's lattice tets into the parts held: `core_tets[i]` (ids into
+/// `points`) into `parts[i]`, with pass 0 (none where the list is
+/// missing). Redistribution (§8) then sends each to the lowest part its
+/// points' DDG hosts give, as it does a front's.
+pub(crate) fn add_core_tets(
+    parts: &mut [Part],
+    (points, point_size): (&[P3], &[f64]),
+    core_tets: &[Vec<[u32; 4]>],
+) {
+    for (part, block) in parts.iter_mut().zip(core_tets) {
+        part.tets.reserve_exact(block.len());
+        part.tet_pass.reserve_exact(block.len());
+        for t in block {
+            let v = t.map(|i| {
+                part.local(Rec {
+                    gid: i,
+                    p: points[i as usize],
+                    h: point_size[i as usize],
+                })
+            });
+            part.tets.push(v);
+            part.tet_pass.push(0);
+        }
+    }
+}
+
 impl Part {
     pub(crate) fn local(&mut self, r: Rec) -> u32 {
         if let Some(&i) = self.index.get(&r.gid) {

@@ -2,6 +2,7 @@
 //! mesher on each region, its parts' messages through a `Comm`, and the end
 //! of a partitioned run whose mesh stays in its pieces.
 use super::*;
+use parafront_lattice::Lattice;
 
 /// The parallel mesher (§5 to §8, `parallel`: `mesh_parallel`, or one
 /// that fails in tests) on each region, its parts' messages through
@@ -51,12 +52,22 @@ pub(crate) fn mesh_parts<C: Comm>(
         // The lattice fills the core; the passes mesh the layer between it
         // and the surface.
         let n_in = pts.len() as u32;
-        let lattice = region_lattice(&pts, &hs, rf, sizing, opts, sum);
+        let mut lattice = region_lattice(&pts, &hs, rf, sizing, opts, sum);
         pts.extend_from_slice(&lattice.points);
         hs.extend_from_slice(&lattice.size);
         let core: Vec<[u32; 3]> = lattice.faces.iter().map(|f| f.map(|v| v + n_in)).collect();
+        // In pieces the lattice's tets go with the fronts' (§8), each
+        // process holding only its parts' blocks; a merged mesh takes them
+        // whole below.
+        let core_tets = if opts.gather {
+            Vec::new()
+        } else {
+            note_lattice(&lattice, next_base, sum, &mut lattice_inner);
+            core_blocks(&mut lattice, n_in, comm.owned(), comm.parts())
+        };
         let t_par = Instant::now();
-        let out = match parallel(&pts, &hs, &rf.faces, &core, &field, &popts, comm) {
+        let around = (&core[..], &core_tets[..]);
+        let out = match parallel(&pts, &hs, &rf.faces, around, &field, &popts, comm) {
             Ok(out) => out,
             // A valid surface must not fail (AF5, step 4): a front the
             // passes leave unclosable (CAD needles next to a part wall) gets
@@ -120,7 +131,8 @@ pub(crate) fn mesh_parts<C: Comm>(
         // pieces' global ids; none when there are no pieces to keep.
         let pieces_base = if !opts.gather {
             let base = next_base;
-            next_base += out.n_points - pts.len() as u32;
+            // The lattice's points are the region's first new ones.
+            next_base += out.n_points - n_in;
             sum.points = next_base as usize;
             Some(base)
         } else if holds {
@@ -128,8 +140,8 @@ pub(crate) fn mesh_parts<C: Comm>(
             tets.extend(lattice.tets.iter().map(|t| t.map(|v| v + n_in)));
             let base = append_region(mesh, rf, &out.points, &tets);
             note_lattice(&lattice, base, sum, &mut lattice_inner);
-            // The lattice's tets are in no piece: no pieces then (`--pvtu`
-            // turns the lattice off).
+            // The lattice's tets are in no piece of a merged run: no pieces
+            // then (`--pvtu` turns the lattice off).
             lattice.tets.is_empty().then_some(base)
         } else {
             None
@@ -157,11 +169,36 @@ pub(crate) fn mesh_parts<C: Comm>(
     Ok(lattice_inner)
 }
 
+/// The lattice's tets (ids offset by `n_in`, the region's surface points)
+/// of the parts `owned` of `np`, one list per part: part `k` gets the
+/// `k`-th of `np` blocks by index, the same on any number of processes.
+/// The lattice keeps none (the summary has counted them): a process
+/// holds only its blocks.
+fn core_blocks(
+    lattice: &mut Lattice,
+    n_in: u32,
+    owned: std::ops::Range<usize>,
+    np: usize,
+) -> Vec<Vec<[u32; 4]>> {
+    let n = lattice.tets.len();
+    let np = np.max(1);
+    let blocks = owned
+        .map(|k| {
+            lattice.tets[k * n / np..(k + 1) * n / np]
+                .iter()
+                .map(|t| t.map(|v| v + n_in))
+                .collect()
+        })
+        .collect();
+    lattice.tets = Vec::new();
+    blocks
+}
+
 type ParallelMesher<C> = fn(
     &[parafront_geom::P3],
     &[f64],
     &[[u32; 3]],
-    &[[u32; 3]],
+    (&[[u32; 3]], &[Vec<[u32; 4]>]),
     &(dyn Fn(parafront_geom::P3) -> f64 + Sync),
     &ParOptions,
     &C,
@@ -169,13 +206,15 @@ type ParallelMesher<C> = fn(
 
 /// The end of a partitioned run (`gather` off): the pieces improved,
 /// checked and measured where they lie, the counts summed over the
-/// processes; the mesh is empty.
+/// processes; the mesh is empty. `lattice_inner`: the global ids of the
+/// lattice's inner points, which improvement leaves alone.
 pub(crate) fn finish_pieces<C: Comm>(
     s: &Surface,
     fronts: &[RegionFront],
     sizing: &Sizing,
     opts: &MeshOptions,
     comm: &C,
+    lattice_inner: &[u32],
     mut sum: Summary,
 ) -> Result<(TetMesh, Summary), MeshError> {
     if opts.optimize > 0 {
@@ -186,8 +225,15 @@ pub(crate) fn finish_pieces<C: Comm>(
             level: opts.optimize,
             parts: opts.optimize_parts,
         };
-        let (st, n) =
-            crate::pieces::improve_pieces(comm, &mut sum.pieces, &region, s.points.len(), &io)?;
+        let mut inner = lattice_inner.to_vec();
+        inner.sort_unstable();
+        let (st, n) = crate::pieces::improve_pieces(
+            comm,
+            &mut sum.pieces,
+            &region,
+            (s.points.len(), &inner),
+            &io,
+        )?;
         sum.improve = Some(st);
         sum.points = n;
         sum.push(Stage::Improve, t0.elapsed().as_secs_f64());
@@ -252,7 +298,7 @@ mod tests {
             _: &[parafront_geom::P3],
             _: &[f64],
             _: &[[u32; 3]],
-            _: &[[u32; 3]],
+            _: (&[[u32; 3]], &[Vec<[u32; 4]>]),
             _: &(dyn Fn(parafront_geom::P3) -> f64 + Sync),
             _: &ParOptions,
             _: &parafront_comm::Threads,

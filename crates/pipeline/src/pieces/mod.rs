@@ -47,15 +47,18 @@ struct Improved {
 /// `r`'s piece of part `owned().start + i`, region ids in `region`) and
 /// numbers their points and tets again over all processes; the summed
 /// statistics of this process and the point count of the whole mesh.
+/// `lattice_inner`: the global ids (sorted) of the lattice's inner points,
+/// frozen in the first round, their tets set aside (they are ideal).
 pub(crate) fn improve_pieces<C: Comm>(
     comm: &C,
     pieces: &mut Vec<Piece>,
     region: &[u32],
-    n_input: usize,
+    (n_input, lattice_inner): (usize, &[u32]),
     io: &ImproveOptions,
 ) -> Result<(ImproveStats, usize), MeshError> {
     let mut st = ImproveStats::default();
-    improve_round(comm, pieces, region, n_input, io, None, &mut st)?;
+    let first = Round::First { lattice_inner };
+    improve_round(comm, pieces, region, n_input, io, first, &mut st)?;
     // §9.5: the tets at each cut go to the lower piece, and a second round
     // improves the former cuts: the points within a few layers of tets of
     // them move, the rest (improved in the first round) stay.
@@ -67,7 +70,15 @@ pub(crate) fn improve_pieces<C: Comm>(
             .collect()
     });
     shift_all(comm, pieces, region)?;
-    let n = improve_round(comm, pieces, region, n_input, io, Some(&cut), &mut st)?;
+    let n = improve_round(
+        comm,
+        pieces,
+        region,
+        n_input,
+        io,
+        Round::Near(&cut),
+        &mut st,
+    )?;
     // §9.4's last lift, across the cuts: a tet under the lift's floor near
     // a cut of the second round had points frozen there. Such a tet and
     // the tets around it go to one piece, and a third round frees only the
@@ -97,7 +108,15 @@ pub(crate) fn improve_pieces<C: Comm>(
         return Ok((st, n));
     }
     move_clusters(comm, pieces, region, &bad)?;
-    let n = improve_round(comm, pieces, region, n_input, io, Some(&bad), &mut st)?;
+    let n = improve_round(
+        comm,
+        pieces,
+        region,
+        n_input,
+        io,
+        Round::Near(&bad),
+        &mut st,
+    )?;
     Ok((st, n))
 }
 
@@ -157,17 +176,26 @@ fn per_region<C: Comm>(
     Ok(())
 }
 
-/// One round: every piece improved with its boundary and cuts frozen (and,
-/// with `near`, every point farther than a few layers of tets from the
-/// points whose global ids it lists), then the points and tets numbered
-/// again; the whole mesh's point count.
+/// Which points a round frees besides the pieces' boundaries and cuts.
+#[derive(Clone, Copy)]
+enum Round<'a> {
+    /// Every point but the lattice's inner ones (global ids, sorted).
+    First { lattice_inner: &'a [u32] },
+    /// The points within a few layers of tets of those listed (global
+    /// ids, sorted).
+    Near(&'a [u32]),
+}
+
+/// One round: every piece improved with its boundary and cuts frozen (and
+/// the points `round` keeps), then the points and tets numbered again; the
+/// whole mesh's point count.
 fn improve_round<C: Comm>(
     comm: &C,
     pieces: &mut [Piece],
     region: &[u32],
     n_input: usize,
     io: &ImproveOptions,
-    near: Option<&[u32]>,
+    round: Round<'_>,
     st: &mut ImproveStats,
 ) -> Result<usize, MeshError> {
     let held = comm.owned().len();
@@ -178,7 +206,7 @@ fn improve_round<C: Comm>(
         .par_iter_mut()
         .enumerate()
         .with_max_len(1)
-        .map(|(i, pc)| improve_piece(pc, region[i / held.max(1)], n_input, io, near))
+        .map(|(i, pc)| improve_piece(pc, region[i / held.max(1)], n_input, io, round))
         .collect::<Result<_, _>>()?;
     let done: Vec<Improved> = done
         .into_iter()
@@ -256,8 +284,9 @@ fn improve_round<C: Comm>(
 }
 
 /// One piece improved with its boundary and cuts frozen, and its run's
-/// statistics. With `near`, only the points within [`SHIFT_LAYERS`]
-/// layers of tets of those it lists (global ids, sorted) are free, and only
+/// statistics. In the first round the lattice's inner points are frozen
+/// too and their tets set aside. With `Round::Near`, only the points within
+/// [`SHIFT_LAYERS`] layers of tets of those it lists are free, and only
 /// their balls are improved, cut out as a mesh of their own (§9.5's second
 /// pass works on the tets near the former cuts alone); none when no point
 /// is free.
@@ -268,8 +297,12 @@ fn improve_piece(
     region: u32,
     n_input: usize,
     io: &ImproveOptions,
-    near: Option<&[u32]>,
+    round: Round<'_>,
 ) -> Result<(Improved, Option<ImproveStats>), MeshError> {
+    let (near, lattice_inner) = match round {
+        Round::First { lattice_inner } => (None, lattice_inner),
+        Round::Near(ids) => (Some(ids), &[][..]),
+    };
     let mut on_boundary = vec![false; pc.points.len()];
     for (j, &g) in pc.gid.iter().enumerate() {
         on_boundary[j] = (g as usize) < n_input;
@@ -303,8 +336,11 @@ fn improve_piece(
         None => {
             // Faces in one tet of the piece (its boundary and its cuts) are
             // frozen by the improver itself.
+            let inner: Vec<u32> = (0..pc.gid.len() as u32)
+                .filter(|&j| lattice_inner.binary_search(&pc.gid[j as usize]).is_ok())
+                .collect();
             let mut mesh = whole();
-            let st = parafront_improve::improve(&mut mesh, &[], io)
+            let st = crate::lattice::improve_around_lattice(&mut mesh, 0, &inner, io)
                 .map_err(|source| MeshError::Improve { source })?;
             (mesh, Some(st))
         }
