@@ -7,6 +7,8 @@
     python3 scripts/bench.py --sets hard --threads 2 --peers gmsh-hxt,tetgen --append
     python3 scripts/bench.py --sets bench1e6mpi --peers none --append \
         --binary target/release/parafront   # built with --features mpi
+    python3 scripts/bench.py --sets bench5e6mem --peers none --threads 1 \
+        --repeat 1 --append --binary ...    # issue 22: peak per rank
 
 parafront is timed as a user times it: the whole `parafront mesh` process,
 default options, from start to exit (reading, meshing, improvement, checks,
@@ -90,6 +92,11 @@ SETS = {
                     ("bench/box2holes_1e6.stl", ["--parts", "8", "--mpi", "2"]),
                     ("bench/sphere_1e6.stl", ["--size", "0.037", "--parts", "8"]),
                     ("bench/sphere_1e6.stl", ["--size", "0.037", "--parts", "8", "--mpi", "2"])],
+    # Issue 22's memory: the pieces (`--pieces` is bench.py's: -o x.pvtu,
+    # merged for meshcheck) of sphere_5e6 at about 5e6 tets, one process
+    # beside 4 ranks, at 8 and 32 parts; the notes give each process's peak.
+    "bench5e6mem": [("bench/sphere_5e6.stl", ["--size", "0.021", "--parts", p] + m)
+                    for p in ["8", "32"] for m in [["--pieces"], ["--pieces", "--mpi", "4"]]],
 }
 
 
@@ -145,6 +152,10 @@ def parse_summary(out):
     r["region_fill"] = "filled whole" in out
     m = re.search(r"^lattice: \d+ tets in \d+ cubes, ([\d.]+)% of the tets", out, re.M)
     r["lattice_pct"] = float(m.group(1)) if m else None
+    m = re.search(r"^peak memory: ([\d.]+) MiB", out, re.M)
+    r["peak_mib"] = float(m.group(1)) if m else None
+    m = re.search(r"^peak memory per process: ([\d., ]+) MiB", out, re.M)
+    r["rank_peaks"] = [float(x) for x in m.group(1).split(",")] if m else None
     return r
 
 
@@ -153,6 +164,8 @@ def run_parafront(binary, surf, extra, threads, out_mesh):
     process's VmHWM): wait4's ru_maxrss would count the Python process the
     child was forked from."""
     cmd = [binary, "mesh", surf, "-o", out_mesh, "--threads", str(threads)] + extra
+    if "--pieces" in cmd:
+        cmd.remove("--pieces")
     if "--mpi" in extra:
         i = cmd.index("--mpi")
         ranks = cmd[i + 1]
@@ -171,6 +184,13 @@ def run_parafront(binary, surf, extra, threads, out_mesh):
 
 
 def meshcheck(surf, mesh, healed):
+    if mesh.endswith(".pvtu"):
+        merged = mesh[:-5] + ".merged.vtu"
+        p = subprocess.run([sys.executable, os.path.join(ROOT, "scripts", "merge_pvtu.py"), mesh, merged],
+                           capture_output=True, text=True)
+        if p.returncode != 0:
+            return False
+        mesh = merged
     cmd = [sys.executable, os.path.join(SHARED, "tools", "meshcheck.py"), "--surface",
            healed or surf, mesh, "--quiet"]
     p = subprocess.run(cmd, capture_output=True, text=True)
@@ -237,12 +257,14 @@ def main():
                 print(f"skip {rel}: not found", file=sys.stderr)
                 continue
             name = os.path.basename(surf)
-            mesh = os.path.join(work, name + ".vtu")
+            mesh = os.path.join(work, name + (".pvtu" if "--pieces" in extra else ".vtu"))
             if "--size" in extra:
                 name += " --size " + extra[extra.index("--size") + 1]
             if "--parts" in extra:
                 name += " --parts " + extra[extra.index("--parts") + 1]
             ranks = 1
+            if "--pieces" in extra:
+                name += " -o .pvtu"
             if "--mpi" in extra:
                 ranks = int(extra[extra.index("--mpi") + 1])
                 name += f" on {ranks} ranks"
@@ -270,7 +292,12 @@ def main():
                              f"{last['fill_cavities']} / {last['fill_tets']}"
                              + (" (region)" if last["region_fill"] else "")
                              + (f"; lattice {last['lattice_pct']:.0f} %"
-                                if last["lattice_pct"] is not None else "")])
+                                if last["lattice_pct"] is not None else "")
+                             + (f"; peak per process {min(last['rank_peaks']):.0f}-"
+                                f"{max(last['rank_peaks']):.0f} MiB"
+                                if last["rank_peaks"] else
+                                f"; peak {last['peak_mib']:.0f} MiB" if "--pieces" in extra
+                                and last["peak_mib"] is not None else "")])
                 stages = {}
                 for r in runs:
                     for k, v in r.get("stages", {}).items():
