@@ -454,14 +454,25 @@ fn a_pvtu_output_keeps_the_pieces() {
     let pv0 = tmp("demo_pieces0.pvtu");
     let (said0, _, m0) = pieces(&["--optimize", "0"], &pv0);
     m0.check_against_surface(&demo.tris).unwrap();
-    let vol = tmp("demo_merged.vtu");
+    assert_eq!(
+        gathered_tets("demo_merged.vtu", &["--optimize", "0"]),
+        said0
+    );
+}
+
+/// The tets of the demo's merged run at `--parts 4 <args>`, written to
+/// `name`.
+fn gathered_tets(name: &str, args: &[&str]) -> usize {
+    let vol = tmp(name);
     let o = bin()
-        .args(["demo", "--parts", "4", "--optimize", "0", "-o"])
+        .args(["demo", "--parts", "4"])
+        .args(args)
+        .arg("-o")
         .arg(&vol)
         .output()
         .unwrap();
-    assert!(o.status.success());
-    assert_eq!(parafront_io::read_mesh(&vol).unwrap().tets.len(), said0);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    parafront_io::read_mesh(&vol).unwrap().tets.len()
 }
 
 /// `-o x.pvtu` with a lattice core (§2, a size bound and `--lattice on`;
@@ -486,25 +497,10 @@ fn a_pvtu_output_holds_the_lattice() {
     assert_eq!(m.tets.len(), said);
     m.check_against_surface(&demo.tris).unwrap();
     let pv0 = tmp("lattice_pieces0.pvtu");
-    let (said0, _, m0) = demo_pieces(&demo, 4, &[&on[..], &["--optimize", "0"]].concat(), &pv0);
+    let unimproved = [&on[..], &["--optimize", "0"]].concat();
+    let (said0, _, m0) = demo_pieces(&demo, 4, &unimproved, &pv0);
     m0.check_against_surface(&demo.tris).unwrap();
-    let vol = tmp("lattice_merged.vtu");
-    let o = bin()
-        .args([
-            "demo",
-            "--parts",
-            "4",
-            "--size",
-            "0.8",
-            "--optimize",
-            "0",
-            "-o",
-        ])
-        .arg(&vol)
-        .output()
-        .unwrap();
-    assert!(o.status.success());
-    assert_eq!(parafront_io::read_mesh(&vol).unwrap().tets.len(), said0);
+    assert_eq!(gathered_tets("lattice_merged.vtu", &unimproved), said0);
 }
 
 /// `-o x.pvtu` with the parts left to the estimate: the demo, small

@@ -94,13 +94,7 @@ pub(crate) fn seed_parts(
         let part = &mut parts[k - owned.start];
         let block = k * faces.len() / holders..(k + 1) * faces.len() / holders;
         for f in &faces[block] {
-            let v = f.map(|i| {
-                part.local(Rec {
-                    gid: i,
-                    p: points[i as usize],
-                    h: point_size[i as usize],
-                })
-            });
+            let v = f.map(|i| part.local_input(i, (points, point_size)));
             part.front.push(v);
         }
     }
@@ -120,13 +114,7 @@ pub(crate) fn add_core_tets(
         part.tets.reserve_exact(block.len());
         part.tet_pass.reserve_exact(block.len());
         for t in block {
-            let v = t.map(|i| {
-                part.local(Rec {
-                    gid: i,
-                    p: points[i as usize],
-                    h: point_size[i as usize],
-                })
-            });
+            let v = t.map(|i| part.local_input(i, (points, point_size)));
             part.tets.push(v);
             part.tet_pass.push(0);
         }
@@ -144,6 +132,14 @@ impl Part {
         self.gid.push(r.gid);
         self.index.insert(r.gid, i);
         i
+    }
+    /// [`Part::local`] of input point `i` (its global id).
+    fn local_input(&mut self, i: u32, (points, point_size): (&[P3], &[f64])) -> u32 {
+        self.local(Rec {
+            gid: i,
+            p: points[i as usize],
+            h: point_size[i as usize],
+        })
     }
     pub(crate) fn rec(&self, i: u32) -> Rec {
         Rec {
