@@ -624,20 +624,20 @@ fn write_pieces<C: Comm>(
     let t0 = Instant::now();
     let held = comm.owned();
     let n = held.len();
-    // Which pieces have tets, over all processes: region by region, one
-    // flag per part.
-    let mut filled = Vec::with_capacity(sum.pieces.len() * comm.parts() / n.max(1));
-    for r in 0..sum.parallel.len() {
-        let local: Vec<u8> = (0..n)
+    // The tets of each piece, over all processes: region by region, one
+    // count per part (every process has every region's pieces).
+    let mut tets = Vec::with_capacity(sum.regions * comm.parts());
+    for r in 0..sum.regions {
+        let local: Vec<u64> = (0..n)
             .map(|i| {
                 sum.pieces
                     .get(r * n + i)
-                    .map_or(0, |pc| u8::from(!pc.tets.is_empty()))
+                    .map_or(0, |pc| pc.tets.len() as u64)
             })
             .collect();
-        filled.extend(comm.all_gather(local).into_iter().map(|f| f > 0));
+        tets.extend(comm.all_gather(local).into_iter().map(|c| c as usize));
     }
-    let res = parallel::write_partitioned_share(out, sum, w, held, &filled);
+    let res = parallel::write_partitioned_share(out, sum, w, held, &tets);
     let failed = comm.all_reduce(vec![res.is_err() as u8; n], u8::max);
     let files = match res {
         Err(e) => return Err(e),
@@ -674,7 +674,7 @@ fn write_pieces<C: Comm>(
                     .join(", ")
             );
         }
-        let total = filled.iter().filter(|&&f| f).count();
+        let total = tets.iter().filter(|&&c| c > 0).count();
         println!("wrote {} ({total} pieces)", out.display());
     }
     drop(files);

@@ -84,31 +84,32 @@ pub fn print_parallel(sum: &Summary) {
 /// points another part owns, and the number of parts sharing each point.
 /// Returns the number of pieces written (empty ones are left out).
 pub fn write_partitioned(path: &Path, sum: &Summary, w: &WriteOptions) -> Result<usize, Fail> {
-    let parts = sum.parallel.first().map_or(0, |st| st.parts);
-    let filled: Vec<bool> = sum.pieces.iter().map(|pc| !pc.tets.is_empty()).collect();
-    write_partitioned_share(path, sum, w, 0..parts, &filled)?;
-    Ok(filled.iter().filter(|&&f| f).count())
+    let tets: Vec<usize> = sum.pieces.iter().map(|pc| pc.tets.len()).collect();
+    write_partitioned_share(path, sum, w, 0..sum.piece_parts, &tets)?;
+    Ok(tets.iter().filter(|&&n| n > 0).count())
 }
 
 /// [`write_partitioned`] for the parts `held` of this process (MPI): its
-/// pieces, and the index where part 0 is held. `filled[r * parts + k]`:
-/// whether region r's piece of part k has tets, over all processes; an
-/// empty piece is neither written nor named (meshio cannot read a piece
+/// pieces, and the index where part 0 is held. `tets[r * parts + k]`:
+/// the tets of region r's piece of part k, over all processes; an empty
+/// piece is neither written nor named (meshio cannot read a piece
 /// without cells). Returns the files written.
 pub(crate) fn write_partitioned_share(
     path: &Path,
     sum: &Summary,
     w: &WriteOptions,
     held: std::ops::Range<usize>,
-    filled: &[bool],
+    tets: &[usize],
 ) -> Result<Vec<std::path::PathBuf>, Fail> {
     if sum.pieces.is_empty() && held.start == 0 {
         return Err(Fail(2, "--pvtu needs --parts > 1".into()));
     }
-    if let Some((r, _)) = sum.serial_fallback.first() {
+    // A merged run keeps no pieces of a region the serial front meshed.
+    if sum.pieces.len() < sum.regions * held.len() {
+        let r = sum.serial_fallback.first().map_or(0, |f| f.0);
         return Err(Fail(
             1,
-            format!("--pvtu: region {r} was meshed by the serial front (its passes failed or left most of it to pass 4), so there is no partitioned mesh to write"),
+            format!("--pvtu: region {r} was meshed by the serial front (its passes failed or left most of it to pass 4), so there is no partitioned mesh to write beside the merged one; -o x.pvtu alone writes its pieces"),
         ));
     }
     struct Arrays {
@@ -122,12 +123,14 @@ pub(crate) fn write_partitioned_share(
     }
     // Pieces come region by region, `parts` per region; global cell ids
     // are per region, so each region starts after the ones before it.
-    let parts = sum.parallel[0].parts;
+    let parts = sum.piece_parts.max(1);
     let n_held = held.len().max(1);
-    let mut region_base = vec![0i64; sum.parallel.len() + 1];
-    for (r, st) in sum.parallel.iter().enumerate() {
-        region_base[r + 1] = region_base[r] + st.pass_tets.iter().sum::<usize>() as i64;
-    }
+    let region_base: Vec<i64> = std::iter::once(0)
+        .chain(tets.chunks(parts).scan(0i64, |at, c| {
+            *at += c.iter().sum::<usize>() as i64;
+            Some(*at)
+        }))
+        .collect();
     // The pieces with tets: each its index in `sum.pieces`, and its region.
     let shown: Vec<(usize, usize)> = (0..sum.pieces.len())
         .filter(|&i| !sum.pieces[i].tets.is_empty())
@@ -185,7 +188,7 @@ pub(crate) fn write_partitioned_share(
         }
     }
     let index = held.start == 0 && !held.is_empty();
-    let listed: Vec<usize> = (0..filled.len()).filter(|&i| filled[i]).collect();
+    let listed: Vec<usize> = (0..tets.len()).filter(|&i| tets[i] > 0).collect();
     let mut written = write_pvtu_share(path, &ids, &listed, index, arrays, piece, w)?;
     if index {
         written.push(path.to_path_buf());

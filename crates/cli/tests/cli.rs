@@ -503,6 +503,24 @@ fn a_pvtu_output_holds_the_lattice() {
     assert_eq!(gathered_tets("lattice_merged.vtu", &unimproved), said0);
 }
 
+/// `-o x.pvtu` where the passes give way (`--serial-from 0`: any volume
+/// left to pass 4 sends a region to the serial front): the serial front's
+/// mesh is sent to the parts, and the pieces merge into a valid mesh of
+/// the surface; unimproved, they are the gathered run's tets.
+#[test]
+fn a_pvtu_output_takes_the_serial_front_where_the_passes_give_way() {
+    let demo = parafront_surface::generate::demo_part();
+    let serial = ["--serial-from", "0"];
+    let (said, text, m) = demo_pieces(&demo, 4, &serial, &tmp("serial_pieces.pvtu"));
+    assert!(text.contains("meshed by the serial front"), "{text}");
+    assert_eq!(m.tets.len(), said);
+    m.check_against_surface(&demo.tris).unwrap();
+    let unimproved = [&serial[..], &["--optimize", "0"]].concat();
+    let (said0, _, m0) = demo_pieces(&demo, 4, &unimproved, &tmp("serial_pieces0.pvtu"));
+    m0.check_against_surface(&demo.tris).unwrap();
+    assert_eq!(gathered_tets("serial_merged.vtu", &unimproved), said0);
+}
+
 /// `-o x.pvtu` with the parts left to the estimate: the demo, small
 /// enough for the serial front, gets two parts (pieces need parts), and
 /// the pieces are those of `--parts 2`, byte for byte, a valid mesh of

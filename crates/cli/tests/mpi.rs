@@ -148,6 +148,10 @@ fn every_rank_writes_its_pieces_of_a_pvtu() {
     // inner points frozen.
     let lattice = ["demo", "--parts", "8", "--size", "0.8", "--lattice", "on"];
     pieces_match_threads("pvtu_lattice", &lattice);
+    // Passes that give way: the serial front's mesh, made on the rank of
+    // part 0, sent to the parts.
+    let serial = ["demo", "--parts", "8", "--serial-from", "0"];
+    pieces_match_threads("pvtu_serial", &serial);
 }
 
 /// `args` plus `-o x.pvtu` on the threads backend, then on 2 and 4 ranks:

@@ -507,17 +507,7 @@ fn brio_order(points: &[P3]) -> Vec<usize> {
         .map(|k| bb.max[k] - bb.min[k])
         .fold(0.0, f64::max)
         .max(1e-300);
-    let key = |p: &P3| -> u64 {
-        let q: [u64; 3] =
-            [0, 1, 2].map(|d| (((p[d] - bb.min[d]) / ext * 1_048_575.0) as u64).min(1_048_575));
-        let mut k = 0u64;
-        for bit in (0..20).rev() {
-            for &c in &q {
-                k = (k << 1) | ((c >> bit) & 1);
-            }
-        }
-        k
-    };
+    let key = |p: &P3| parafront_geom::morton_key(*p, bb.min, ext);
     let mut idx: Vec<(u64, usize)> = points
         .iter()
         .enumerate()

@@ -8,10 +8,12 @@
 pub mod aabb;
 pub mod intersect;
 pub mod kernel;
+pub mod morton;
 pub mod predicates;
 pub mod vec3;
 
 pub use aabb::Aabb;
+pub use morton::morton_key;
 pub use predicates::{in_sphere, orient2d, orient3d, orient3d_sign, Sign};
 pub use vec3::*;
 

@@ -12,7 +12,9 @@ mod pieces;
 mod serial;
 use lattice::{note_lattice, region_lattice};
 use parts::{finish_pieces, mesh_parts};
-use serial::{append_region, global_id, mesh_serial, region_points, serial_region};
+use serial::{
+    append_region, global_id, mesh_serial, region_points, serial_region, serial_region_mesh,
+};
 mod regions;
 mod share;
 mod summary;

@@ -2,7 +2,9 @@
 //! mesher on each region, its parts' messages through a `Comm`, and the end
 //! of a partitioned run whose mesh stays in its pieces.
 use super::*;
+use parafront_geom::{Aabb, P3};
 use parafront_lattice::Lattice;
+use parafront_passes::{move_pieces, Piece};
 
 /// The parallel mesher (§5 to §8, `parallel`: `mesh_parallel`, or one
 /// that fails in tests) on each region, its parts' messages through
@@ -59,6 +61,7 @@ pub(crate) fn mesh_parts<C: Comm>(
         // In pieces the lattice's tets go with the fronts' (§8), each
         // process holding only its parts' blocks; a merged mesh takes them
         // whole below.
+        let noted = (lattice_inner.len(), sum.lattice_tets, sum.lattice_cells);
         let core_tets = if opts.gather {
             Vec::new()
         } else {
@@ -90,10 +93,23 @@ pub(crate) fn mesh_parts<C: Comm>(
                     .push((rf.region_id as usize, e.to_string()));
                 sum.push(Stage::PassesGivenUp, t_par.elapsed().as_secs_f64());
                 if !opts.gather {
-                    return Err(MeshError::Partitioned(format!(
-                        "region {}: the parallel passes gave way ({e}), and the serial front makes no pieces",
-                        rf.region_id
-                    )));
+                    // The lattice noted for the pieces is not in this mesh.
+                    lattice_inner.truncate(noted.0);
+                    (sum.lattice_tets, sum.lattice_cells) = (noted.1, noted.2);
+                    let t0 = Instant::now();
+                    let (pieces, n_points) = serial_pieces(s, rf, sizing, opts, sum, comm)?;
+                    sum.push(Stage::Front, t0.elapsed().as_secs_f64());
+                    let base = next_base;
+                    next_base += n_points - rf.points.len() as u32;
+                    sum.points = next_base as usize;
+                    for mut pc in pieces {
+                        for g in &mut pc.gid {
+                            *g = global_id(rf, base, *g);
+                        }
+                        sum.pieces.push(pc);
+                    }
+                    sum.piece_parts = comm.parts();
+                    continue;
                 }
                 if !holds {
                     continue; // the serial front runs where the mesh gathers
@@ -157,6 +173,7 @@ pub(crate) fn mesh_parts<C: Comm>(
                 }
                 sum.pieces.push(pc);
             }
+            sum.piece_parts = comm.parts();
         }
         sum.parallel.push(out.stats);
     }
@@ -167,6 +184,89 @@ pub(crate) fn mesh_parts<C: Comm>(
         sum.push(name, x);
     }
     Ok(lattice_inner)
+}
+
+/// The serial front's mesh of region `rf` as pieces, for a run whose
+/// passes gave way: made by the process of part 0, with the lattice off
+/// (whose inner points the pieces' improvement would have to know on
+/// every process), then each tet sent to its part by §8's redistribution,
+/// each part an equal run of the tets along a Morton curve of their
+/// centroids. This process's pieces (region-local point ids) and the
+/// region's point count.
+fn serial_pieces<C: Comm>(
+    s: &Surface,
+    rf: &RegionFront,
+    sizing: &Sizing,
+    opts: &MeshOptions,
+    sum: &mut Summary,
+    comm: &C,
+) -> Result<(Vec<Piece>, u32), MeshError> {
+    let held = comm.owned().len();
+    let made = comm.holds(0).then(|| {
+        let serial = MeshOptions {
+            lattice: LatticeMode::Off,
+            ..opts.clone()
+        };
+        serial_region_mesh(s, rf, sizing, &serial, sum)
+    });
+    // Part 0's process says the point count, or u32::MAX for a failure,
+    // so that no process waits on a front that failed.
+    let mut said = vec![0u32; held];
+    if let Some(m) = &made {
+        said[0] = m.as_ref().map_or(u32::MAX, |rm| rm.points.len() as u32);
+    }
+    let n_points = comm.all_gather(said)[0];
+    let mut pieces: Vec<Piece> = (0..held).map(|_| Piece::default()).collect();
+    let mut dst: Vec<Vec<u32>> = vec![Vec::new(); held];
+    match made {
+        Some(Err(e)) => return Err(e),
+        Some(Ok(rm)) => {
+            dst[0] = curve_parts(&rm.points, &rm.tets, comm.parts());
+            let pc = &mut pieces[0];
+            pc.gid = (0..rm.points.len() as u32).collect();
+            pc.tet_pass = vec![4; rm.tets.len()];
+            pc.points = rm.points;
+            pc.tets = rm.tets;
+        }
+        None if n_points == u32::MAX => {
+            return Err(MeshError::Partitioned(format!(
+                "region {}: the serial front failed on the process of part 0",
+                rf.region_id
+            )))
+        }
+        None => {}
+    }
+    let pieces = move_pieces(comm, pieces, dst).map_err(|source| MeshError::Parallel {
+        region: rf.region_id as usize,
+        source,
+    })?;
+    Ok((pieces, n_points))
+}
+
+/// Each tet's part of `np`: equal runs of the tets in the Morton order of
+/// their centroids (ties by index).
+fn curve_parts(points: &[P3], tets: &[[u32; 4]], np: usize) -> Vec<u32> {
+    let bb = Aabb::from_points(points.iter());
+    let ext = (0..3)
+        .map(|k| bb.max[k] - bb.min[k])
+        .fold(0.0, f64::max)
+        .max(1e-300);
+    let mut order: Vec<(u64, u32)> = tets
+        .iter()
+        .enumerate()
+        .map(|(t, tv)| {
+            let c = tv.map(|v| points[v as usize]);
+            let mid = [0, 1, 2].map(|k| 0.25 * (c[0][k] + c[1][k] + c[2][k] + c[3][k]));
+            (parafront_geom::morton_key(mid, bb.min, ext), t as u32)
+        })
+        .collect();
+    order.sort_unstable();
+    let n = order.len().max(1);
+    let mut part = vec![0u32; tets.len()];
+    for (i, &(_, t)) in order.iter().enumerate() {
+        part[t as usize] = (i * np / n) as u32;
+    }
+    part
 }
 
 /// The lattice's tets (ids offset by `n_in`, the region's surface points)

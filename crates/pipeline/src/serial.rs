@@ -32,6 +32,36 @@ pub(crate) fn serial_region(
     sum: &mut Summary,
     lattice_inner: &mut Vec<u32>,
 ) -> Result<(), MeshError> {
+    let rm = serial_region_mesh(s, rf, sizing, opts, sum)?;
+    let base = append_region(mesh, rf, &rm.points, &rm.tets);
+    if let Some(lattice) = &rm.lattice {
+        note_lattice(lattice, base, sum, lattice_inner);
+    }
+    Ok(())
+}
+
+/// One region's mesh in its local ids: its surface points first (in the
+/// order of `rf.points`), then its new ones.
+pub(crate) struct RegionMesh {
+    pub(crate) points: Vec<parafront_geom::P3>,
+    pub(crate) tets: Vec<[u32; 4]>,
+    /// The lattice whose points and tets it holds (§2), where it does.
+    pub(crate) lattice: Option<parafront_lattice::Lattice>,
+}
+
+/// The serial front's mesh of region `rf`.
+pub(crate) fn serial_region_mesh(
+    s: &Surface,
+    rf: &RegionFront,
+    sizing: &Sizing,
+    opts: &MeshOptions,
+    sum: &mut Summary,
+) -> Result<RegionMesh, MeshError> {
+    let filled = |(points, tets)| RegionMesh {
+        points,
+        tets,
+        lattice: None,
+    };
     let field = |p| sizing.size(p);
     let (points, point_size) = region_points(s, sizing, rf);
     // §2's optimal space-filling tets: the lattice's points follow the
@@ -77,11 +107,10 @@ pub(crate) fn serial_region(
         if !matches!(res, Err(FrontError::HandOver)) {
             break res;
         }
-        if let Some((all, tets)) = fill_whole(s, sizing, rf, &lattice.points) {
-            append_region(mesh, rf, &all, &tets);
+        if let Some(fill) = fill_whole(s, sizing, rf, &lattice.points) {
             sum.regions_refined.push(region);
-            sum.fill_tets += tets.len();
-            return Ok(());
+            sum.fill_tets += fill.1.len();
+            return Ok(filled(fill));
         }
         hand_over = false;
     };
@@ -91,25 +120,22 @@ pub(crate) fn serial_region(
         // whole surface, refined to the size field by Delaunay insertion
         // (GDT, §2), unless a debug dump was asked for.
         Err(e @ FrontError::Stuck { .. }) if !opts.debug_partial => {
-            let Some((all, tets)) = fill_whole(s, sizing, rf, &lattice.points) else {
+            let Some(fill) = fill_whole(s, sizing, rf, &lattice.points) else {
                 return Err(MeshError::Front { region, source: e });
             };
             tracing::warn!(
                 region,
-                tets = tets.len(),
+                tets = fill.1.len(),
                 "the front could not close the region: filled whole by the constrained fill"
             );
-            append_region(mesh, rf, &all, &tets);
             sum.regions_filled.push(region);
-            sum.fill_tets += tets.len();
-            return Ok(());
+            sum.fill_tets += fill.1.len();
+            return Ok(filled(fill));
         }
         Err(e) => return Err(MeshError::Front { region, source: e }),
     };
     let mut tets = res.tets;
     tets.extend(lattice.tets.iter().map(|t| t.map(|v| v + n_in)));
-    let base = append_region(mesh, rf, &res.points, &tets);
-    note_lattice(&lattice, base, sum, lattice_inner);
     sum.recovery_rounds += res.stats.recovery_rounds;
     sum.tets_removed += res.stats.tets_removed;
     sum.cavities_filled += res.stats.cavities_filled;
@@ -118,7 +144,11 @@ pub(crate) fn serial_region(
     if res.stats.regions_refined > 0 {
         sum.regions_refined.push(region);
     }
-    Ok(())
+    Ok(RegionMesh {
+        points: res.points,
+        tets,
+        lattice: Some(lattice),
+    })
 }
 
 /// Region `rf`'s whole surface filled by the constrained fill, refined to

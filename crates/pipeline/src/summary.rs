@@ -148,6 +148,8 @@ pub struct Summary {
     /// the mesh stays in its pieces or improvement is off (improvement
     /// renumbers the merged mesh).
     pub pieces: Vec<Piece>,
+    /// The parts of each region's pieces in `pieces` (0: none kept).
+    pub piece_parts: usize,
 }
 
 impl Summary {

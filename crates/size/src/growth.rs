@@ -263,17 +263,7 @@ impl SurfaceGrowth {
             cen[1] - root_s / 2.0,
             cen[2] - root_s / 2.0,
         ];
-        let morton = |p: P3| {
-            let mut key = 0u64;
-            let q =
-                [0, 1, 2].map(|k| (((p[k] - root_lo[k]) / root_s * 1048575.0) as u64).min(1048575));
-            for bit in (0..20).rev() {
-                for qk in q {
-                    key = (key << 1) | ((qk >> bit) & 1);
-                }
-            }
-            key
-        };
+        let morton = |p: P3| parafront_geom::morton_key(p, root_lo, root_s);
         let mut s: Vec<Seed> = seeds.iter().map(|&(p, h)| Seed { p, h }).collect();
         s.sort_by_cached_key(|sd| morton(sd.p));
         let mut g = SurfaceGrowth {
