@@ -383,22 +383,31 @@ fn demo_pieces(
         String::from_utf8_lossy(&o.stderr)
     );
     let said = tets_said(&text);
+    let (n, m) = merge_pieces(demo, pv, parts);
+    // Two regions on `parts` parts, no piece empty (a part may hold none
+    // of the small region).
+    assert!(n <= 2 * parts && n > parts, "{n} pieces");
+    (said, text, m)
+}
+
+/// The pieces `pv` names (`parts` per region), merged by exact
+/// coordinates, the surface's points first; and how many there are.
+fn merge_pieces(
+    surface: &parafront_surface::Surface,
+    pv: &Path,
+    parts: u32,
+) -> (u32, parafront_mesh::TetMesh) {
     let index = std::fs::read_to_string(pv).unwrap();
     let names: Vec<&str> = index
         .split("Source=\"")
         .skip(1)
         .map(|s| s.split('"').next().unwrap())
         .collect();
-    // Two regions on `parts` parts, no piece empty (a part may hold none
-    // of the small region).
-    let n = names.len() as u32;
-    assert!(n <= 2 * parts && n > parts, "{index}");
-    // Merged by exact coordinates, the surface's points first.
     let mut m = parafront_mesh::TetMesh {
-        points: demo.points.clone(),
+        points: surface.points.clone(),
         ..Default::default()
     };
-    let mut id: std::collections::HashMap<[u64; 3], u32> = demo
+    let mut id: std::collections::HashMap<[u64; 3], u32> = surface
         .points
         .iter()
         .enumerate()
@@ -433,7 +442,7 @@ fn demo_pieces(
                 .map(|t| t.map(|p| parafront_mesh::PointId::from_raw(local[p.idx()]))),
         );
     }
-    (said, text, m)
+    (names.len() as u32, m)
 }
 
 /// `-o x.pvtu`: the mesh stays in its pieces (no merged mesh; under MPI
@@ -519,6 +528,49 @@ fn a_pvtu_output_takes_the_serial_front_where_the_passes_give_way() {
     let (said0, _, m0) = demo_pieces(&demo, 4, &unimproved, &tmp("serial_pieces0.pvtu"));
     m0.check_against_surface(&demo.tris).unwrap();
     assert_eq!(gathered_tets("serial_merged.vtu", &unimproved), said0);
+}
+
+/// A thin plate's passes give way before they start (its depth is under
+/// an edge): `-o x.pvtu --parts 4` gets the serial front's mesh in four
+/// pieces of about equal size, also after their improvement, whose shifts
+/// had moved every tet of a thin part into one piece; merged, they are a
+/// valid mesh of the plate with the summary's tets.
+#[test]
+fn a_thin_part_in_pieces_keeps_its_parts() {
+    let s = parafront_surface::generate::needle_plate(0.5, 64);
+    let surf = tmp("thin_plate.stl");
+    parafront_io::write_surface(&surf, &s, &Default::default()).unwrap();
+    let pv = tmp("thin_plate.pvtu");
+    let o = bin()
+        .arg("mesh")
+        .arg(&surf)
+        .args(["--parts", "4", "-o"])
+        .arg(&pv)
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&o.stdout).to_string();
+    assert!(
+        o.status.success(),
+        "{text}{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(text.contains("meshed by the serial front"), "{text}");
+    let sizes: Vec<usize> = (0..4)
+        .map(|k| {
+            let piece = pv.with_file_name(format!("thin_plate_{k}.vtu"));
+            parafront_io::read_mesh(&piece).unwrap().tets.len()
+        })
+        .collect();
+    let said = tets_said(&text);
+    assert_eq!(sizes.iter().sum::<usize>(), said);
+    for &n in &sizes {
+        assert!(4 * n > said / 2 && 4 * n < 3 * said / 2, "{sizes:?}");
+    }
+    let (named, m) = merge_pieces(&s, &pv, 4);
+    assert_eq!(named, 4);
+    m.check_against_surface(&s.tris).unwrap();
+    let v: f64 = m.volume();
+    assert!((v - s.signed_volume()).abs() < 1e-9 * v, "{v}");
 }
 
 /// `-o x.pvtu` with the parts left to the estimate: the demo, small

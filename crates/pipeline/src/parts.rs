@@ -2,7 +2,6 @@
 //! mesher on each region, its parts' messages through a `Comm`, and the end
 //! of a partitioned run whose mesh stays in its pieces.
 use super::*;
-use parafront_geom::{Aabb, P3};
 use parafront_lattice::Lattice;
 use parafront_passes::{move_pieces, Piece};
 
@@ -221,7 +220,7 @@ fn serial_pieces<C: Comm>(
     match made {
         Some(Err(e)) => return Err(e),
         Some(Ok(rm)) => {
-            dst[0] = curve_parts(&rm.points, &rm.tets, comm.parts());
+            dst[0] = crate::pieces::curve_parts(&rm.points, &rm.tets, comm.parts());
             let pc = &mut pieces[0];
             pc.gid = (0..rm.points.len() as u32).collect();
             pc.tet_pass = vec![4; rm.tets.len()];
@@ -241,32 +240,6 @@ fn serial_pieces<C: Comm>(
         source,
     })?;
     Ok((pieces, n_points))
-}
-
-/// Each tet's part of `np`: equal runs of the tets in the Morton order of
-/// their centroids (ties by index).
-fn curve_parts(points: &[P3], tets: &[[u32; 4]], np: usize) -> Vec<u32> {
-    let bb = Aabb::from_points(points.iter());
-    let ext = (0..3)
-        .map(|k| bb.max[k] - bb.min[k])
-        .fold(0.0, f64::max)
-        .max(1e-300);
-    let mut order: Vec<(u64, u32)> = tets
-        .iter()
-        .enumerate()
-        .map(|(t, tv)| {
-            let c = tv.map(|v| points[v as usize]);
-            let mid = [0, 1, 2].map(|k| 0.25 * (c[0][k] + c[1][k] + c[2][k] + c[3][k]));
-            (parafront_geom::morton_key(mid, bb.min, ext), t as u32)
-        })
-        .collect();
-    order.sort_unstable();
-    let n = order.len().max(1);
-    let mut part = vec![0u32; tets.len()];
-    for (i, &(_, t)) in order.iter().enumerate() {
-        part[t as usize] = (i * np / n) as u32;
-    }
-    part
 }
 
 /// The lattice's tets (ids offset by `n_in`, the region's surface points)
@@ -334,6 +307,15 @@ pub(crate) fn finish_pieces<C: Comm>(
             (s.points.len(), &inner),
             &io,
         )?;
+        // The serial front's regions, shifted by the rounds' moves (on a
+        // thin part, into one piece), get their runs of the curve again.
+        let fell: Vec<bool> = region
+            .iter()
+            .map(|&r| sum.serial_fallback.iter().any(|f| f.0 == r as usize))
+            .collect();
+        if fell.contains(&true) {
+            crate::pieces::resplit_regions(comm, &mut sum.pieces, &region, &fell)?;
+        }
         sum.improve = Some(st);
         sum.points = n;
         sum.push(Stage::Improve, t0.elapsed().as_secs_f64());

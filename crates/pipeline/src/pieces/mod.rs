@@ -18,9 +18,11 @@ use parafront_improve::{ImproveOptions, ImproveStats};
 use parafront_passes::Piece;
 
 mod clusters;
+mod curve;
 mod report;
 
 use clusters::{move_clusters, near_points, CLUSTER_LAYERS};
+pub(crate) use curve::curve_parts;
 use rayon::prelude::*;
 pub(crate) use report::pieces_quality;
 use rustc_hash::FxHashMap;
@@ -151,6 +153,26 @@ fn gather_ids<C: Comm>(comm: &C, pieces: &[Piece], of: impl Fn(&Piece) -> Vec<u3
 fn shift_all<C: Comm>(comm: &C, pieces: &mut Vec<Piece>, region: &[u32]) -> Result<(), MeshError> {
     per_region(comm, pieces, region, |chunk| {
         parafront_passes::shift_pieces(comm, chunk)
+    })
+}
+
+/// The pieces of the regions `which` picks (by index), split again along
+/// the Morton curve ([`curve::resplit`]): those of the regions the serial
+/// front meshed, after their improvement.
+pub(crate) fn resplit_regions<C: Comm>(
+    comm: &C,
+    pieces: &mut Vec<Piece>,
+    region: &[u32],
+    which: &[bool],
+) -> Result<(), MeshError> {
+    let mut at = 0;
+    per_region(comm, pieces, region, |chunk| {
+        at += 1;
+        if which[at - 1] {
+            curve::resplit(comm, chunk)
+        } else {
+            Ok(chunk)
+        }
     })
 }
 
