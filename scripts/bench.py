@@ -97,12 +97,13 @@ SETS = {
     # beside 4 ranks, at 8 and 32 parts; the notes give each process's peak.
     "bench5e6mem": [("bench/sphere_5e6.stl", ["--size", "0.021", "--parts", p] + m)
                     for p in ["8", "32"] for m in [["--pieces"], ["--pieces", "--mpi", "4"]]],
-    # The thin corpus parts whose passes give way at 8 parts: merged, and
-    # as pieces (the serial front's mesh sent to the parts along a curve).
-    "thinpieces": [(f"valid/{n}", ["--parts", "8"] + m)
+    # The thin corpus parts whose passes give way at 8 parts: by default
+    # (with the peers), merged at 8 parts, and as pieces at 8 parts (the
+    # serial front's mesh sent to the parts along a curve).
+    "thinpieces": [(f"valid/{n}", m)
                    for n in ["1002_tray_bottom.STL", "base_interface_gmsh.stl", "hinge.stl",
                              "plate_holes.STL", "round.stl"]
-                   for m in [[], ["--pieces"]]],
+                   for m in [[], ["--parts", "8"], ["--parts", "8", "--pieces"]]],
 }
 
 
