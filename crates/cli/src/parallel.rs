@@ -84,6 +84,13 @@ pub fn print_parallel(sum: &Summary) {
 /// points another part owns, and the number of parts sharing each point.
 /// Returns the number of pieces written (empty ones are left out).
 pub fn write_partitioned(path: &Path, sum: &Summary, w: &WriteOptions) -> Result<usize, Fail> {
+    // A merged run keeps no pieces of a region the serial front meshed.
+    if let Some(&(r, _)) = sum.serial_fallback.first() {
+        return Err(Fail(
+            1,
+            format!("--pvtu: region {r} was meshed by the serial front (its passes failed or left most of it to pass 4), so there is no partitioned mesh to write beside the merged one; -o x.pvtu alone writes pieces"),
+        ));
+    }
     let tets: Vec<usize> = sum.pieces.iter().map(|pc| pc.tets.len()).collect();
     write_partitioned_share(path, sum, w, 0..sum.piece_parts, &tets)?;
     Ok(tets.iter().filter(|&&n| n > 0).count())
@@ -103,14 +110,6 @@ pub(crate) fn write_partitioned_share(
 ) -> Result<Vec<std::path::PathBuf>, Fail> {
     if sum.pieces.is_empty() && held.start == 0 {
         return Err(Fail(2, "--pvtu needs --parts > 1".into()));
-    }
-    // A merged run keeps no pieces of a region the serial front meshed.
-    if sum.pieces.len() < sum.regions * held.len() {
-        let r = sum.serial_fallback.first().map_or(0, |f| f.0);
-        return Err(Fail(
-            1,
-            format!("--pvtu: region {r} was meshed by the serial front (its passes failed or left most of it to pass 4), so there is no partitioned mesh to write beside the merged one; -o x.pvtu alone writes its pieces"),
-        ));
     }
     struct Arrays {
         mesh: TetMesh,

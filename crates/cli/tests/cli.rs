@@ -359,6 +359,18 @@ print("tets", total)
     assert!(out.contains(&format!("tets {said}")), "{out} vs {said}");
 }
 
+/// The stdout of a run that must have succeeded (else its output is the
+/// failure's message).
+fn stdout_ok(o: &std::process::Output) -> String {
+    let text = String::from_utf8_lossy(&o.stdout).to_string();
+    assert!(
+        o.status.success(),
+        "{text}{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    text
+}
+
 /// The demo's pieces written by `demo --parts <parts> <args> -o pv` (a
 /// .pvtu), merged by exact coordinates (the surface's points first,
 /// regions from the piece numbers): the tet count the summary gives, the
@@ -376,12 +388,7 @@ fn demo_pieces(
         .arg(pv)
         .output()
         .unwrap();
-    let text = String::from_utf8_lossy(&o.stdout).to_string();
-    assert!(
-        o.status.success(),
-        "{text}{}",
-        String::from_utf8_lossy(&o.stderr)
-    );
+    let text = stdout_ok(&o);
     let said = tets_said(&text);
     let (n, m) = merge_pieces(demo, pv, parts);
     // Two regions on `parts` parts, no piece empty (a part may hold none
@@ -548,12 +555,7 @@ fn a_thin_part_in_pieces_keeps_its_parts() {
         .arg(&pv)
         .output()
         .unwrap();
-    let text = String::from_utf8_lossy(&o.stdout).to_string();
-    assert!(
-        o.status.success(),
-        "{text}{}",
-        String::from_utf8_lossy(&o.stderr)
-    );
+    let text = stdout_ok(&o);
     assert!(text.contains("meshed by the serial front"), "{text}");
     let sizes: Vec<usize> = (0..4)
         .map(|k| {
@@ -571,6 +573,22 @@ fn a_thin_part_in_pieces_keeps_its_parts() {
     m.check_against_surface(&s.tris).unwrap();
     let v: f64 = m.volume();
     assert!((v - s.signed_volume()).abs() < 1e-9 * v, "{v}");
+    // Pieces beside a merged mesh (`--pvtu`) are the passes' own: none
+    // here, which the error says.
+    let beside = tmp("thin_plate_beside.pvtu");
+    let o = bin()
+        .arg("mesh")
+        .arg(&surf)
+        .args(["--parts", "4", "--optimize", "0", "-o"])
+        .arg(tmp("thin_plate.vtu"))
+        .arg("--pvtu")
+        .arg(&beside)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains("meshed by the serial front"), "{err}");
+    assert!(!beside.exists());
 }
 
 /// `-o x.pvtu` with the parts left to the estimate: the demo, small
@@ -582,12 +600,7 @@ fn a_pvtu_output_with_auto_parts_gets_two_at_least() {
     let demo = parafront_surface::generate::demo_part();
     let pv = tmp("auto_pieces.pvtu");
     let o = bin().args(["demo", "-o"]).arg(&pv).output().unwrap();
-    let text = String::from_utf8_lossy(&o.stdout).to_string();
-    assert!(
-        o.status.success(),
-        "{text}{}",
-        String::from_utf8_lossy(&o.stderr)
-    );
+    let text = stdout_ok(&o);
     assert!(text.contains("parts (auto): 2 parts"), "{text}");
     let given = tmp("given_pieces.pvtu");
     let (said, _, m) = demo_pieces(&demo, 2, &[], &given);
