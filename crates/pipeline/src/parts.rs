@@ -99,15 +99,9 @@ pub(crate) fn mesh_parts<C: Comm>(
                     let (pieces, n_points) = serial_pieces(s, rf, sizing, opts, sum, comm)?;
                     sum.push(Stage::Front, t0.elapsed().as_secs_f64());
                     let base = next_base;
-                    next_base += n_points - rf.points.len() as u32;
+                    next_base += n_points - n_in;
                     sum.points = next_base as usize;
-                    for mut pc in pieces {
-                        for g in &mut pc.gid {
-                            *g = global_id(rf, base, *g);
-                        }
-                        sum.pieces.push(pc);
-                    }
-                    sum.piece_parts = comm.parts();
+                    keep_pieces(sum, rf, base, pieces, comm.parts());
                     continue;
                 }
                 if !holds {
@@ -164,15 +158,9 @@ pub(crate) fn mesh_parts<C: Comm>(
         // Improvement renumbers the merged mesh, so its pieces would go
         // stale; they are a second copy of the mesh (13 of sphere_1e6's
         // 77 MB peak, which came in the improvement).
-        let keep_pieces = !opts.gather || opts.optimize == 0;
-        if let Some(base) = pieces_base.filter(|_| keep_pieces) {
-            for mut pc in out.pieces {
-                for g in &mut pc.gid {
-                    *g = global_id(rf, base, *g);
-                }
-                sum.pieces.push(pc);
-            }
-            sum.piece_parts = comm.parts();
+        let kept = !opts.gather || opts.optimize == 0;
+        if let Some(base) = pieces_base.filter(|_| kept) {
+            keep_pieces(sum, rf, base, out.pieces, comm.parts());
         }
         sum.parallel.push(out.stats);
     }
@@ -183,6 +171,18 @@ pub(crate) fn mesh_parts<C: Comm>(
         sum.push(name, x);
     }
     Ok(lattice_inner)
+}
+
+/// Region `rf`'s pieces (of `parts` parts) into the summary, their points'
+/// global ids from the region's local ones (its new points from `base`).
+fn keep_pieces(sum: &mut Summary, rf: &RegionFront, base: u32, pieces: Vec<Piece>, parts: usize) {
+    for mut pc in pieces {
+        for g in &mut pc.gid {
+            *g = global_id(rf, base, *g);
+        }
+        sum.pieces.push(pc);
+    }
+    sum.piece_parts = parts;
 }
 
 /// The serial front's mesh of region `rf` as pieces, for a run whose

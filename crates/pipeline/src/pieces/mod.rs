@@ -165,10 +165,9 @@ pub(crate) fn resplit_regions<C: Comm>(
     region: &[u32],
     which: &[bool],
 ) -> Result<(), MeshError> {
-    let mut at = 0;
+    let mut which = which.iter();
     per_region(comm, pieces, region, |chunk| {
-        at += 1;
-        if which[at - 1] {
+        if which.next() == Some(&true) {
             curve::resplit(comm, chunk)
         } else {
             Ok(chunk)
