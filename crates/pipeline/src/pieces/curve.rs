@@ -51,13 +51,20 @@ pub(crate) fn resplit<C: Comm>(comm: &C, pieces: Vec<Piece>) -> Result<Vec<Piece
         .map(|[min, max]| Aabb { min, max })
         .filter(|b| !b.is_empty())
         .fold(Aabb::EMPTY, |a, b| a.union(&b));
-    let (lo, ext) = cube(bb);
+    // Each axis over its own extent: in the cube of the longest one, a
+    // needle's tets fell in a few buckets (needle_frustum at 8 parts: 3
+    // pieces).
+    let ext = [0, 1, 2].map(|k| (bb.max[k] - bb.min[k]).max(1e-300));
+    let unit = |c: P3| [0, 1, 2].map(|k| (c[k] - bb.min[k]) / ext[k]);
     let buckets: Vec<Vec<u32>> = pieces
         .iter()
         .map(|pc| {
             pc.tets
                 .iter()
-                .map(|tv| (morton_key(centroid(&pc.points, tv), lo, ext) >> BUCKET_SHIFT) as u32)
+                .map(|tv| {
+                    let c = unit(centroid(&pc.points, tv));
+                    (morton_key(c, [0.0; 3], 1.0) >> BUCKET_SHIFT) as u32
+                })
                 .collect()
         })
         .collect();
