@@ -117,14 +117,14 @@ fn extremes(d: &[f64; 6]) -> (f64, f64) {
 pub fn tet_qualities(mesh: &TetMesh) -> Vec<Option<TetQuality>> {
     mesh.tets
         .par_iter()
-        .map(|t| tet_coords(mesh, t).map(tet_quality))
+        .map(|t| tet_coords(&mesh.points, t).map(tet_quality))
         .collect()
 }
 
-fn tet_coords(mesh: &TetMesh, t: &[PointId; 4]) -> Option<[P3; 4]> {
+fn tet_coords(points: &[P3], t: &[PointId; 4]) -> Option<[P3; 4]> {
     let mut c = [[0.0; 3]; 4];
     for k in 0..4 {
-        c[k] = *mesh.points.get(t[k].idx())?;
+        c[k] = *points.get(t[k].idx())?;
     }
     Some(c)
 }
@@ -457,17 +457,31 @@ impl QualityReport {
         Self::compute(mesh, Some(size))
     }
 
+    /// Shape quality of the tets `tets` over `points` (some of a mesh's
+    /// tets: [`QualityReport::merge`] adds reports of the others).
+    pub fn of_tets(points: &[P3], tets: &[[PointId; 4]]) -> QualityReport {
+        Self::compute_over(points, tets, None::<(&TetMesh, fn(P3) -> f64)>)
+    }
+
     fn compute(mesh: &TetMesh, size: Option<impl Fn(P3) -> f64 + Sync>) -> QualityReport {
+        let edges = size.map(|h| (mesh, h));
+        Self::compute_over(&mesh.points, &mesh.tets, edges)
+    }
+
+    fn compute_over(
+        points: &[P3],
+        tets: &[[PointId; 4]],
+        edges: Option<(&TetMesh, impl Fn(P3) -> f64 + Sync)>,
+    ) -> QualityReport {
         // Chunks of tets, merged in order: the same sums whatever the
         // threads, and no accumulator moved per tet (its copies were a
         // tenth of the report's time).
-        let accs: Vec<Acc> = mesh
-            .tets
+        let accs: Vec<Acc> = tets
             .par_chunks(REPORT_CHUNK)
             .map(|ch| {
                 let mut a = Acc::new();
                 for t in ch {
-                    let Some(p) = tet_coords(mesh, t) else {
+                    let Some(p) = tet_coords(points, t) else {
                         a.skipped += 1;
                         continue;
                     };
@@ -504,11 +518,11 @@ impl QualityReport {
             })
             .collect();
         let acc = accs.into_iter().fold(Acc::new(), Acc::merge);
-        let n = mesh.tets.len();
+        let n = tets.len();
         let measured = n - acc.skipped;
-        let (edge_ratio, edge_ratio_hist) = match size {
+        let (edge_ratio, edge_ratio_hist) = match edges {
             None => (None, None),
-            Some(h) => {
+            Some((mesh, h)) => {
                 let mut s = StatAcc::EMPTY;
                 let mut hist = Histogram::new(0.0, 3.0, 30);
                 for_each_edge_size_ratio(mesh, h, |r| {

@@ -206,6 +206,29 @@ fn merged_reports_of_two_halves_are_the_whole() {
     assert!(g.edge_ratio.unwrap().count >= whole.edge_ratio.unwrap().count);
 }
 
+/// The report of some of a mesh's tets is that of a mesh of those tets
+/// alone, and two such reports merge into the whole's shape report.
+#[test]
+fn a_report_of_some_tets_is_theirs() {
+    let m = box_mesh(4, 3, 2, [0.0; 3], [2.0, 1.5, 1.0]);
+    let cut = m.tets.len() / 3;
+    let head = TetMesh {
+        points: m.points.clone(),
+        tets: m.tets[..cut].to_vec(),
+        ..Default::default()
+    };
+    let a = QualityReport::of_tets(&m.points, &m.tets[..cut]);
+    assert_eq!(a, QualityReport::new(&head));
+    let g = a.merge(&QualityReport::of_tets(&m.points, &m.tets[cut..]));
+    let whole = QualityReport::new(&m);
+    assert_eq!(g.n_tets, whole.n_tets);
+    assert_eq!(g.radius_ratio_hist, whole.radius_ratio_hist);
+    assert_eq!(g.max_dihedral_hist, whole.max_dihedral_hist);
+    assert_eq!(g.min_dihedral.min, whole.min_dihedral.min);
+    assert!((g.radius_ratio.mean - whole.radius_ratio.mean).abs() < 1e-12);
+    assert!(g.edge_ratio.is_none());
+}
+
 /// A box large enough that the edges are taken in several slices: each
 /// edge still counted once, and the histogram holds them all.
 #[test]

@@ -500,20 +500,24 @@ fn mesh_sized<C: Comm>(
     };
     opts.release();
 
+    let mut improved = None;
     if opts.optimize > 0 {
         opts.note_phase(parafront_front::Phase::Improving);
         // The report before improvement is the improvement's cost.
         let t0 = Instant::now();
-        sum.quality_before = Some(QualityReport::new(&mesh));
         // The surface points (ids below s.points.len()) never move (§9.3),
         // nor do the lattice's inner points: their tets are already ideal.
         let io = parafront_improve::ImproveOptions {
             level: opts.optimize,
             parts: opts.optimize_parts,
         };
-        let st = lattice::improve_around_lattice(&mut mesh, s.points.len(), &lattice_inner, &io)
-            .map_err(|source| MeshError::Improve { source })?;
-        sum.improve = Some(st);
+        let n_surface = s.points.len();
+        let mut done =
+            lattice::improve_around_lattice(&mut mesh, n_surface, &lattice_inner, &io, true)
+                .map_err(|source| MeshError::Improve { source })?;
+        sum.quality_before = done.before.take();
+        sum.improve = Some(done.stats.clone());
+        improved = Some(done);
         sum.push(Stage::Improve, t0.elapsed().as_secs_f64());
         opts.release();
     }
@@ -529,14 +533,18 @@ fn mesh_sized<C: Comm>(
         mesh.build_adjacency()
             .map_err(|source| MeshError::Adjacency { source })?;
     } else {
-        mesh.check_against_surface(&s.tris)?;
+        let st = mesh.check_against_surface(&s.tris)?;
         // Exactly positive is not enough: a solver computes volumes in
-        // floating point, and so does meshcheck.py.
-        if let Some(t) = (0..mesh.tets.len()).find(|&t| {
-            let p = mesh.tet_points(parafront_mesh::TetId::new(t));
+        // floating point, and so does meshcheck.py. The check has the
+        // smallest; the tet is looked for only when it is not positive.
+        let flat = |t: &usize| {
+            let p = mesh.tet_points(parafront_mesh::TetId::new(*t));
             parafront_geom::tet_volume6(p[0], p[1], p[2], p[3]) <= 0.0
-        }) {
-            return Err(MeshError::FloatVolume { tet: t });
+        };
+        if st.min_volume <= 0.0 {
+            if let Some(t) = (0..mesh.tets.len()).find(flat) {
+                return Err(MeshError::FloatVolume { tet: t });
+            }
         }
     }
     sum.push(Stage::Check, t0.elapsed().as_secs_f64());
@@ -546,6 +554,8 @@ fn mesh_sized<C: Comm>(
         let t0 = Instant::now();
         sum.quality = Some(if opts.size_report {
             QualityReport::with_size(&mesh, |p| sizing.size(p))
+        } else if let Some(done) = &improved {
+            done.report_after(&mesh)
         } else {
             QualityReport::new(&mesh)
         });

@@ -116,3 +116,47 @@ fn the_passes_mesh_around_the_lattice() {
     assert!((volume(&a) - volume(&serial)).abs() < 1e-9 * volume(&serial));
     assert!(QualityReport::new(&a).min_dihedral.min > 10.0);
 }
+
+/// The summary's quality of a lattice run adds the report of the tets
+/// improvement set aside to that of the others: it is the final mesh's,
+/// counts and extremes exactly, means to rounding; the report before
+/// improvement counts the front's mesh.
+#[test]
+fn the_reported_quality_is_the_meshs_own() {
+    let s = generate::icosphere([0.0; 3], 1.0, 4);
+    let o = MeshOptions {
+        size: SizeOptions {
+            h: Some(0.08),
+            ..SizeOptions::default()
+        },
+        lattice: LatticeMode::On,
+        ..MeshOptions::default()
+    };
+    let (m, sum) = mesh_surface(&s, &o).unwrap();
+    assert!(sum.lattice_tets * 3 > m.tets.len());
+    let (got, want) = (sum.quality.expect("a report"), QualityReport::new(&m));
+    assert_eq!(got.n_tets, want.n_tets);
+    assert_eq!(got.n_inverted, want.n_inverted);
+    assert_eq!(got.dihedral_hist, want.dihedral_hist);
+    assert_eq!(got.min_dihedral_hist, want.min_dihedral_hist);
+    assert_eq!(got.max_dihedral_hist, want.max_dihedral_hist);
+    assert_eq!(got.radius_ratio_hist, want.radius_ratio_hist);
+    assert_eq!(got.mean_ratio_hist, want.mean_ratio_hist);
+    assert_eq!(got.share_min_dihedral_below, want.share_min_dihedral_below);
+    for (a, b) in [
+        (got.min_dihedral, want.min_dihedral),
+        (got.max_dihedral, want.max_dihedral),
+        (got.radius_ratio, want.radius_ratio),
+        (got.mean_ratio, want.mean_ratio),
+    ] {
+        assert_eq!((a.min, a.max, a.count), (b.min, b.max, b.count));
+        assert!(
+            (a.mean - b.mean).abs() <= 1e-12 * b.mean.abs(),
+            "{a:?} {b:?}"
+        );
+    }
+    let before = sum.quality_before.expect("improvement ran");
+    let st = sum.improve.expect("improvement ran");
+    assert_eq!(before.n_tets, st.tets_before);
+    assert_eq!(before.dihedral_hist.total(), 6 * st.tets_before as u64);
+}

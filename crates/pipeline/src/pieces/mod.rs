@@ -361,9 +361,9 @@ fn improve_piece(
                 .filter(|&j| lattice_inner.binary_search(&pc.gid[j as usize]).is_ok())
                 .collect();
             let mut mesh = whole();
-            let st = crate::lattice::improve_around_lattice(&mut mesh, 0, &inner, io)
+            let done = crate::lattice::improve_around_lattice(&mut mesh, 0, &inner, io, false)
                 .map_err(|source| MeshError::Improve { source })?;
-            (mesh, Some(st))
+            (mesh, Some(done.stats))
         }
         Some(free) if free.contains(&true) => {
             let (mesh, st) = improve_balls(pc, region, &free, io)?;
