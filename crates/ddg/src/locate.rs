@@ -653,17 +653,21 @@ mod tests {
             .collect()
     }
 
-    /// Inside points, corners, edge midpoints, face centroids and points of
-    /// the torus' box, in a scrambled order.
-    fn probes(d: &Ddg) -> Vec<P3> {
-        let mut out = d.points.clone();
-        let mut x = 0x9e37_79b9_7f4a_7c15u64;
-        let mut rnd = move || {
+    /// Uniform in [0, 1): xorshift64 from `x`.
+    fn rng(mut x: u64) -> impl FnMut() -> f64 {
+        move || {
             x ^= x << 13;
             x ^= x >> 7;
             x ^= x << 17;
             (x >> 11) as f64 / (1u64 << 53) as f64
-        };
+        }
+    }
+
+    /// Inside points, corners, edge midpoints, face centroids and points of
+    /// the torus' box, in a scrambled order.
+    fn probes(d: &Ddg) -> Vec<P3> {
+        let mut out = d.points.clone();
+        let mut rnd = rng(0x9e37_79b9_7f4a_7c15);
         for t in 0..d.tets.len() {
             let q = d.tet_points(t);
             let mid = |a: P3, b: P3| [0, 1, 2].map(|k| 0.5 * (a[k] + b[k]));
@@ -801,13 +805,7 @@ mod tests {
     /// points in it, on boxes of many sizes about many places.
     #[test]
     fn boxes_on_the_grid_hold_their_points() {
-        let mut x = 0x2545_f491_4f6c_dd1du64;
-        let mut rnd = move || {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
-            (x >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rnd = rng(0x2545_f491_4f6c_dd1d);
         let all = Aabb {
             min: [-3.7, 0.1, 1e3],
             max: [2.9, 0.1000001, 1e3 + 1e-9],
