@@ -12,7 +12,7 @@ use std::time::Instant;
 
 /// What [`improve_around_lattice`] did, and the quality reports it
 /// leaves for the summary.
-pub(crate) struct Improved {
+pub(crate) struct LatticeImproved {
     pub(crate) stats: ImproveStats,
     /// The quality of the mesh before improvement, when asked for.
     pub(crate) before: Option<QualityReport>,
@@ -23,7 +23,7 @@ pub(crate) struct Improved {
     pub(crate) aside: Option<(usize, QualityReport)>,
 }
 
-impl Improved {
+impl LatticeImproved {
     /// The quality of the improved `mesh` (shapes only).
     pub(crate) fn report_after(&self, mesh: &TetMesh) -> QualityReport {
         match &self.aside {
@@ -48,11 +48,11 @@ pub(crate) fn improve_around_lattice(
     inner: &[u32],
     io: &ImproveOptions,
     reports: bool,
-) -> Result<Improved, TopoError> {
+) -> Result<LatticeImproved, TopoError> {
     if inner.is_empty() {
         let before = reports.then(|| QualityReport::new(mesh));
         let stats = improve(mesh, &vec![true; n_surface], io)?;
-        return Ok(Improved {
+        return Ok(LatticeImproved {
             stats,
             before,
             aside: None,
@@ -109,7 +109,7 @@ pub(crate) fn improve_around_lattice(
     mesh.neigh.clear();
     stats.tets_before += aside.len();
     stats.tets_after += aside.len();
-    Ok(Improved {
+    Ok(LatticeImproved {
         stats,
         before,
         aside: aside_report.map(|r| (aside.len(), r)),
