@@ -503,10 +503,8 @@ fn brio_order(points: &[P3]) -> Vec<usize> {
         return Vec::new();
     }
     let bb = Aabb::from_points(points);
-    let ext = (0..3)
-        .map(|k| bb.max[k] - bb.min[k])
-        .fold(0.0, f64::max)
-        .max(1e-300);
+    let a = bb.longest_axis();
+    let ext = (bb.max[a] - bb.min[a]).max(1e-300);
     let key = |p: &P3| parafront_geom::morton_key(*p, bb.min, ext);
     let mut idx: Vec<(u64, usize)> = points
         .iter()

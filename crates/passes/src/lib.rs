@@ -34,7 +34,7 @@ use serial::*;
 pub use check::{check_pieces, PieceCheck, PieceCheckError};
 pub use ddg_build::{build_ddg, DdgBuildStats};
 pub use parafront_ddg::Partition;
-pub use redistribute::{move_pieces, shift_pieces, Piece};
+pub use redistribute::{move_pieces, piece_boxes, shift_pieces, Piece};
 
 use parafront_comm::Comm;
 use parafront_ddg::{self as ddg, Ddg, Interfaces, Locator, PartFilter, Shift};

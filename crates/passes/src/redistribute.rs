@@ -365,22 +365,26 @@ fn number_tets<C: Comm>(comm: &C, pieces: &mut [Keyed]) {
     }
 }
 
+/// The box of every part's piece (empty for none), from every process:
+/// `pieces` are those this process holds, in order.
+pub fn piece_boxes<'a, C: Comm>(comm: &C, pieces: impl Iterator<Item = &'a Piece>) -> Vec<Aabb> {
+    comm.all_gather(
+        pieces
+            .map(|pc| {
+                let b = Aabb::from_points(pc.points.iter());
+                [b.min, b.max]
+            })
+            .collect(),
+    )
+    .into_iter()
+    .map(|[min, max]| Aabb { min, max })
+    .collect()
+}
+
 /// Each piece's neighbours and shared points (the send/receive lists),
 /// and each point's owner: the lowest part that holds it.
 fn share_points<C: Comm>(comm: &C, pieces: &mut [Keyed]) {
-    let boxes: Vec<Aabb> = comm
-        .all_gather(
-            pieces
-                .iter()
-                .map(|p| {
-                    let b = Aabb::from_points(p.0.points.iter());
-                    [b.min, b.max]
-                })
-                .collect(),
-        )
-        .into_iter()
-        .map(|[min, max]| Aabb { min, max })
-        .collect();
+    let boxes = piece_boxes(comm, pieces.iter().map(|p| &p.0));
     let start = comm.owned().start;
     let out: Vec<Vec<(u32, Vec<Key>)>> = pieces
         .par_iter()

@@ -6,7 +6,7 @@
 //! pieces had become one).
 use super::*;
 use parafront_geom::{morton_key, Aabb, P3};
-use parafront_passes::{move_pieces, PassError};
+use parafront_passes::{move_pieces, piece_boxes, PassError};
 
 /// Each tet's part of `np`: equal runs of the tets in the Morton order of
 /// their centroids (ties by index).
@@ -37,18 +37,8 @@ const BUCKETS: usize = 1 << 12;
 /// falls in. Global point ids stay.
 pub(crate) fn resplit<C: Comm>(comm: &C, pieces: Vec<Piece>) -> Result<Vec<Piece>, PassError> {
     let np = comm.parts();
-    let bb = comm
-        .all_gather(
-            pieces
-                .iter()
-                .map(|pc| {
-                    let b = Aabb::from_points(pc.points.iter());
-                    [b.min, b.max]
-                })
-                .collect(),
-        )
+    let bb = piece_boxes(comm, pieces.iter())
         .into_iter()
-        .map(|[min, max]| Aabb { min, max })
         .filter(|b| !b.is_empty())
         .fold(Aabb::EMPTY, |a, b| a.union(&b));
     // Each axis over its own extent: in the cube of the longest one, a
@@ -107,11 +97,8 @@ fn cube(b: Aabb) -> (P3, f64) {
     if b.is_empty() {
         return ([0.0; 3], 1.0);
     }
-    let ext = (0..3)
-        .map(|k| b.max[k] - b.min[k])
-        .fold(0.0, f64::max)
-        .max(1e-300);
-    (b.min, ext)
+    let a = b.longest_axis();
+    (b.min, (b.max[a] - b.min[a]).max(1e-300))
 }
 
 fn centroid(points: &[P3], t: &[u32; 4]) -> P3 {
