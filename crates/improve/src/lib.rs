@@ -360,6 +360,15 @@ impl<'m> Improver<'m> {
         !self.w.frozen[p.idx()] && !self.w.dead_pt[p.idx()]
     }
 
+    /// The last passes for the mesh's min dihedral: the worst tets under
+    /// [`LIFT_SWAP_DEG`] lifted by a swap or a point, and their free
+    /// points moved, a few rounds while any changes.
+    pub fn lift_worst(&mut self) -> ImproveStats {
+        let mut st = ImproveStats::default();
+        self.lift_worst_pass(&mut st);
+        st
+    }
+
     /// Drops dead tets and points.
     pub fn finish(self) {
         self.w.compact(true);

@@ -420,3 +420,48 @@ fn swap_that_lifts_the_min_dihedral() {
         min_dihedral(&m)
     );
 }
+
+/// Point 0 inside an octahedron (points 1-6 at +-1 on the axes): the
+/// eight tets of its ball.
+fn octahedron_ball(c: P3) -> TetMesh {
+    let mut pts = vec![c];
+    for k in 0..3 {
+        for s in [1.0, -1.0] {
+            let mut p = [0.0; 3];
+            p[k] = s;
+            pts.push(p);
+        }
+    }
+    let mut tets = Vec::new();
+    for x in [1, 2] {
+        for y in [3, 4] {
+            for z in [5, 6] {
+                tets.push([0, x, y, z]);
+            }
+        }
+    }
+    mesh(pts, &tets)
+}
+
+#[test]
+fn lift_moves_the_free_point_of_a_tet_no_swap_or_point_lifts() {
+    // Off centre, the ball's worst tet is at about 14°, none under 10°:
+    // no swap or new point lifts it, but moving the point back does.
+    let mut m = octahedron_ball([0.25, 0.25, 0.3]);
+    let (tr, vol, d0) = (tris(&m), m.volume(), min_dihedral(&m));
+    assert!(d0 > 10.0 && d0 < 15.0, "{d0}");
+    let mut imp = Improver::new(&mut m, &[]).unwrap();
+    let st = imp.lift_worst();
+    imp.finish();
+    assert_eq!((st.swap.done, st.insert.done), (0, 0));
+    assert!(st.selective.done >= 1);
+    assert_eq!((m.tets.len(), m.points.len()), (8, 7));
+    assert_same_domain(&m, &tr, vol);
+    // The centre's ball is eight tets of 54.7° at best.
+    assert!(min_dihedral(&m) > 50.0, "{}", min_dihedral(&m));
+    assert!(
+        m.points[0].iter().all(|x| x.abs() < 0.05),
+        "{:?}",
+        m.points[0]
+    );
+}
