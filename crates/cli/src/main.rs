@@ -271,6 +271,10 @@ fn main() -> ExitCode {
         libc::mallopt(libc::M_MMAP_THRESHOLD, 256 << 10);
         libc::mallopt(libc::M_TRIM_THRESHOLD, 256 << 10);
     }
+    #[cfg(feature = "mpi")]
+    if mpi_run::launched() {
+        mpi_run::skip_hwloc_plugins();
+    }
     // Diagnostics on stderr, off unless RUST_LOG asks (e.g. RUST_LOG=debug).
     tracing_subscriber::fmt()
         .with_env_filter(tracing_subscriber::EnvFilter::from_default_env())
