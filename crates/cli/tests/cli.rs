@@ -1,17 +1,11 @@
 //! The binary end to end: exit codes and what it writes.
 mod common;
-use common::{have_meshio, meshcheck, tets_said};
+use common::{have_meshio, meshcheck, tets_said, tmp};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
 fn bin() -> Command {
     Command::new(env!("CARGO_BIN_EXE_parafront"))
-}
-
-fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("parafront-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d.join(name)
 }
 
 fn corpus() -> Option<PathBuf> {

@@ -2,7 +2,7 @@
 //! message for a file without triangles, end to end. The corpus tests run
 //! when PARAFRONT_GEOMETRY is set.
 mod common;
-use common::meshcheck;
+use common::{meshcheck, tmp};
 use parafront_io::{write_surface, WriteOptions};
 use parafront_surface::generate::{icosphere, voxels};
 use parafront_surface::read::read_surface;
@@ -13,12 +13,6 @@ use std::process::{Command, Output};
 
 fn bin() -> Command {
     Command::new(env!("CARGO_BIN_EXE_parafront"))
-}
-
-fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("parafront-cli-heal-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d.join(name)
 }
 
 fn run(args: &[&dyn AsRef<std::ffi::OsStr>]) -> (Option<i32>, String, String) {

@@ -5,7 +5,7 @@
 #![cfg(feature = "mpi")]
 
 mod common;
-use common::tets_said;
+use common::{tets_said, tmp};
 
 use parafront_io::{read_mesh, write_surface, WriteOptions};
 use parafront_surface::generate;
@@ -23,12 +23,6 @@ fn mpirun() -> Option<PathBuf> {
     std::env::split_paths(&std::env::var_os("PATH")?)
         .any(|d| d.join("mpirun").is_file())
         .then(|| "mpirun".into())
-}
-
-fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("parafront-mpi-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d.join(name)
 }
 
 struct Run {

@@ -95,12 +95,35 @@ pub fn cube_mesh(n: usize, region: impl Fn(usize) -> u32) -> TetMesh {
     m
 }
 
-/// A fresh empty scratch directory under the system temp dir.
-pub fn scratch(name: &str) -> PathBuf {
+/// A fresh empty scratch directory under the system temp dir, removed
+/// with its files when the test is done with it (dropped).
+pub fn scratch(name: &str) -> Scratch {
     let d = std::env::temp_dir().join(format!("parafront-io-{}-{name}", std::process::id()));
     let _ = std::fs::remove_dir_all(&d);
     std::fs::create_dir_all(&d).unwrap();
-    d
+    Scratch(d)
+}
+
+/// A scratch directory; it goes when this does.
+pub struct Scratch(PathBuf);
+
+impl std::ops::Deref for Scratch {
+    type Target = Path;
+    fn deref(&self) -> &Path {
+        &self.0
+    }
+}
+
+impl AsRef<Path> for Scratch {
+    fn as_ref(&self) -> &Path {
+        &self.0
+    }
+}
+
+impl Drop for Scratch {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
 }
 
 /// Names of the files in `d`, sorted.
