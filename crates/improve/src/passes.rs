@@ -77,8 +77,15 @@ impl Improver<'_> {
     /// moved.
     fn lift_move_once(&mut self, st: &mut ImproveStats) -> usize {
         let worst = self.worst_under_lift();
+        self.move_for_dihedral(&worst, st)
+    }
+
+    /// The free points of `worst` (tets, worst first), each moved to raise
+    /// its ball's min dihedral ([`Work::eval_dihedral`]); how many moved.
+    /// Counted with the selective movement.
+    fn move_for_dihedral(&mut self, worst: &[(f64, u32)], st: &mut ImproveStats) -> usize {
         let mut list = vec![];
-        for (_, t) in worst {
+        for &(_, t) in worst {
             for p in self.w.m.tets[t as usize] {
                 if !self.w.frozen[p.idx()] && !list.contains(&p) {
                     list.push(p);
@@ -528,23 +535,7 @@ impl Improver<'_> {
             .filter(|&(d, _)| d < DIHEDRAL_POLISH)
             .collect();
         worst.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-        let mut list = vec![];
-        for (_, t) in worst {
-            for p in self.w.m.tets[t as usize] {
-                if !self.w.frozen[p.idx()] && !list.contains(&p) {
-                    list.push(p);
-                }
-            }
-        }
-        self.move_in_batches(
-            list,
-            |_, _| true,
-            |w, p, ball, nb| w.eval_dihedral(p, DIHEDRAL_KEEP, ball, nb),
-            |_, _, o| {
-                st.selective.tried += 1;
-                st.selective.done += usize::from(o == Outcome::Done);
-            },
-        );
+        self.move_for_dihedral(&worst, st);
         st.selective.seconds += t0.elapsed().as_secs_f64();
     }
 
