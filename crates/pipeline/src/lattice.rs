@@ -23,17 +23,11 @@ pub(crate) struct LatticeImproved {
     pub(crate) aside: Option<(usize, QualityReport)>,
 }
 
-impl LatticeImproved {
-    /// The quality of the improved `mesh` (shapes only).
-    pub(crate) fn report_after(&self, mesh: &TetMesh) -> QualityReport {
-        match &self.aside {
-            Some((n, r)) => {
-                let kept = &mesh.tets[..mesh.tets.len() - n];
-                QualityReport::of_tets(&mesh.points, kept).merge(r)
-            }
-            None => QualityReport::new(mesh),
-        }
-    }
+/// The quality of the improved `mesh` (shapes only), whose last `n` tets
+/// are those set aside, of report `r` (`LatticeImproved::aside`).
+pub(crate) fn report_after(mesh: &TetMesh, (n, r): &(usize, QualityReport)) -> QualityReport {
+    let kept = &mesh.tets[..mesh.tets.len() - n];
+    QualityReport::of_tets(&mesh.points, kept).merge(r)
 }
 
 /// Improves `mesh`, whose first `n_surface` points are the surface's and

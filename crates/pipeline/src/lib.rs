@@ -500,7 +500,8 @@ fn mesh_sized<C: Comm>(
     };
     opts.release();
 
-    let mut improved = None;
+    // The tets improvement set aside, and their report.
+    let mut aside = None;
     if opts.optimize > 0 {
         opts.note_phase(parafront_front::Phase::Improving);
         // The report before improvement is the improvement's cost.
@@ -512,12 +513,11 @@ fn mesh_sized<C: Comm>(
             parts: opts.optimize_parts,
         };
         let n_surface = s.points.len();
-        let mut done =
-            lattice::improve_around_lattice(&mut mesh, n_surface, &lattice_inner, &io, true)
-                .map_err(|source| MeshError::Improve { source })?;
-        sum.quality_before = done.before.take();
-        sum.improve = Some(done.stats.clone());
-        improved = Some(done);
+        let done = lattice::improve_around_lattice(&mut mesh, n_surface, &lattice_inner, &io, true)
+            .map_err(|source| MeshError::Improve { source })?;
+        sum.quality_before = done.before;
+        sum.improve = Some(done.stats);
+        aside = done.aside;
         sum.push(Stage::Improve, t0.elapsed().as_secs_f64());
         opts.release();
     }
@@ -554,8 +554,8 @@ fn mesh_sized<C: Comm>(
         let t0 = Instant::now();
         sum.quality = Some(if opts.size_report {
             QualityReport::with_size(&mesh, |p| sizing.size(p))
-        } else if let Some(done) = &improved {
-            done.report_after(&mesh)
+        } else if let Some(aside) = &aside {
+            lattice::report_after(&mesh, aside)
         } else {
             QualityReport::new(&mesh)
         });
