@@ -21,6 +21,7 @@ mod ddg_build;
 mod part;
 mod pass;
 mod pockets;
+mod reach;
 mod redistribute;
 mod schedule;
 mod serial;
@@ -360,6 +361,11 @@ pub(crate) trait Regions: Sync {
     fn owner(&self, p: P3) -> Option<u32>;
     /// Per part, a box around its region.
     fn bounds(&self) -> Vec<Aabb>;
+    /// Whether a front face with box `b`, which meets part `k`'s box, may
+    /// come near its region: by default, yes.
+    fn near(&self, _k: u32, _b: &Aabb) -> bool {
+        true
+    }
     /// The region filter of part `k`.
     fn filter(&self, k: u32) -> Box<dyn RegionFilter + '_>;
 }
@@ -370,6 +376,7 @@ struct DdgRegions<'a> {
     loc: &'a Locator<'a>,
     walls: Interfaces,
     part_of: &'a [u32],
+    cells: reach::PartCells,
 }
 
 impl Regions for DdgRegions<'_> {
@@ -389,6 +396,12 @@ impl Regions for DdgRegions<'_> {
                 boxes[k as usize].union(&Aabb::from_points(self.d.tet_points(t).iter()));
         }
         boxes
+    }
+    /// The face's box widened by its longest side (about the local size,
+    /// the reach of the front's checks about a new point).
+    fn near(&self, k: u32, b: &Aabb) -> bool {
+        let ext = (0..3).map(|i| b.max[i] - b.min[i]).fold(0.0, f64::max);
+        self.cells.meets(k, &b.inflated(ext))
     }
     fn filter(&self, k: u32) -> Box<dyn RegionFilter + '_> {
         Box::new(PartFilter::new(self.loc, &self.walls, self.part_of, k))

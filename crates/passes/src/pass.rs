@@ -72,7 +72,7 @@ pub(crate) fn parallel_pass<C: Comm>(
                 };
                 let fb = Aabb::from_points(f.iter().map(|&i| &part.pts[i as usize]));
                 for (q, b) in boxes.iter().enumerate() {
-                    if Some(q as u32) != own && b.overlaps(&fb) {
+                    if Some(q as u32) != own && b.overlaps(&fb) && regions.near(q as u32, &fb) {
                         to.push((q as u32, fi as u32, false));
                     }
                 }

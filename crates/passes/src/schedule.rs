@@ -210,6 +210,7 @@ impl<C: Comm> Passes<'_, C> {
             loc: self.loc,
             walls: Interfaces::new(self.d, part_of),
             part_of,
+            cells: crate::reach::PartCells::new(self.d, part_of, self.comm.parts()),
         };
         let size = Sizes::fine(self.size);
         let (tets, secs) = parallel_pass(
