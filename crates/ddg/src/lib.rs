@@ -8,12 +8,14 @@
 
 mod check;
 mod field;
+mod filter;
 mod locate;
 mod partition;
 
 pub use field::GradedField;
 
-pub use locate::{Interfaces, Locator, PartFilter};
+pub use filter::{Interfaces, PartFilter};
+pub use locate::Locator;
 pub use partition::{
     components, cut_faces, cut_fine_faces, imbalance, order_for_shift, partition, rcb, shift_loads,
     shifted, tet_weights, Partition, Shift,

@@ -1,0 +1,128 @@
+//! The region filter of one part (§7): its walls, the DDG faces between
+//! parts that its edges may not cross, and its points, those the DDG tets
+//! of the part hold.
+use crate::locate::{Bins, Locator, WALK_STEPS};
+use crate::Ddg;
+use parafront_front::{RegionFilter, NO_PLACE};
+use parafront_geom::intersect::{segment_triangle, SegTri};
+use parafront_geom::{Aabb, P3};
+use std::sync::atomic::AtomicU32;
+
+/// The DDG faces between tets of different parts, with both parts: the
+/// walls a part's edges may not cross (§7, the neighbour-to-neighbour
+/// traversal, done here as exact segment-triangle tests).
+#[derive(Clone, Debug)]
+pub struct Interfaces {
+    bins: Bins,
+    boxes: Vec<Aabb>,
+    faces: Vec<[P3; 3]>,
+    sides: Vec<[u32; 2]>,
+}
+
+impl Interfaces {
+    /// The walls of partition `part` (DDG tet -> part) of `d`.
+    pub fn new(d: &Ddg, part: &[u32]) -> Interfaces {
+        let mut faces = Vec::new();
+        let mut sides = Vec::new();
+        for t in 0..d.tets.len() {
+            for f in 0..4 {
+                let n = d.neigh[4 * t + f];
+                if n.is_none() {
+                    continue; // the surface: the front itself stops there
+                }
+                let u = n.tet().idx();
+                if u < t || part[u] == part[t] {
+                    continue;
+                }
+                let tv = d.tets[t];
+                let fv: Vec<P3> = (0..4)
+                    .filter(|&i| i != f)
+                    .map(|i| d.points[tv[i] as usize])
+                    .collect();
+                faces.push([fv[0], fv[1], fv[2]]);
+                sides.push([part[t], part[u]]);
+            }
+        }
+        let boxes: Vec<Aabb> = faces.iter().map(|f| Aabb::from_points(f.iter())).collect();
+        Interfaces {
+            bins: Bins::new(boxes.len(), |i| boxes[i], |_, _| (), |_, _| true, 1.0),
+            boxes,
+            faces,
+            sides,
+        }
+    }
+
+    /// Whether segment `a`-`b` meets a wall of part `k`.
+    pub fn crosses(&self, k: u32, a: P3, b: P3) -> bool {
+        let mut bb = Aabb { min: a, max: a };
+        bb.grow(b);
+        !self.bins.visit(&bb, |x| {
+            if !self.boxes[x as usize].overlaps(&bb) {
+                return true;
+            }
+            let s = self.sides[x as usize];
+            if s[0] != k && s[1] != k {
+                return true;
+            }
+            let [p, q, r] = self.faces[x as usize];
+            matches!(segment_triangle(a, b, p, q, r), SegTri::Disjoint)
+        })
+    }
+}
+
+/// Region filter of part `k` in one pass (§7): a point must lie inside
+/// the part's DDG tets and off its boundary (the conservative assignment),
+/// an edge must not cross a wall of the part.
+pub struct PartFilter<'a> {
+    /// Locates points in the DDG.
+    pub loc: &'a Locator<'a>,
+    /// The walls between parts.
+    pub walls: &'a Interfaces,
+    /// The partition (DDG tet -> part).
+    pub part: &'a [u32],
+    /// The part.
+    pub k: u32,
+    /// The DDG tet of the last point located alone ([`Locator::owner_near`]).
+    pub hint: AtomicU32,
+}
+
+impl<'a> PartFilter<'a> {
+    /// The filter of part `k` of partition `part`, with its walls.
+    pub fn new(loc: &'a Locator<'a>, walls: &'a Interfaces, part: &'a [u32], k: u32) -> Self {
+        PartFilter {
+            loc,
+            walls,
+            part,
+            k,
+            hint: AtomicU32::new(u32::MAX),
+        }
+    }
+}
+
+impl RegionFilter for PartFilter<'_> {
+    fn point_ok(&self, p: P3) -> bool {
+        self.loc.owner_near(p, self.part, &self.hint) == Some(self.k)
+    }
+    fn edge_ok(&self, a: P3, b: P3) -> bool {
+        !self.walls.crosses(self.k, a, b)
+    }
+    /// The place is the DDG tet that holds `p` strictly. `near` is tried
+    /// first, then the last tet found, then the bins.
+    fn locate(&self, p: P3, near: &[u32]) -> (bool, u32) {
+        for (i, &t) in near.iter().enumerate() {
+            if near[..i].contains(&t) {
+                continue;
+            }
+            if let Some(t) = self.loc.walk(t, p, WALK_STEPS) {
+                return (self.part[t as usize] == self.k, t);
+            }
+        }
+        let (own, strict) = self.loc.owner_placed(p, self.part, &self.hint);
+        (own == Some(self.k), strict.unwrap_or(NO_PLACE))
+    }
+    /// Two ends strictly inside one DDG tet: the segment is inside it
+    /// (convex), so it meets no wall.
+    fn edge_ok_at(&self, a: P3, ta: u32, b: P3, tb: u32) -> bool {
+        (ta == tb && ta != NO_PLACE) || self.edge_ok(a, b)
+    }
+}
