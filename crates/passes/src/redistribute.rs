@@ -68,18 +68,31 @@ impl Wire for Batch {
     }
 }
 
-pub(crate) fn run<C: Comm>(
-    parts: Vec<Part>,
+/// Redistribution's first step: each part's tets to their destinations
+/// (from [`destinations`]).
+pub(crate) fn send<C: Comm>(parts: Vec<Part>, dst: Vec<Vec<u32>>, comm: &C) -> Sent {
+    let out = parts
+        .into_par_iter()
+        .zip(dst)
+        .map(|(part, dst)| batches(&part.pts, &part.gid, &part.tets, &part.tet_pass, &dst))
+        .collect();
+    Sent(comm.exchange(out))
+}
+
+/// The tets each held part received by [`send`]: the DDG is no longer
+/// needed for the rest of redistribution.
+pub(crate) struct Sent(Vec<Vec<(u32, Batch)>>);
+
+/// Redistribution after [`send`]: the pieces, their shared points, the
+/// global numbers, and the merged mesh when `opts.gather`.
+pub(crate) fn finish<C: Comm>(
+    Sent(inbox): Sent,
     comm: &C,
-    loc: &Locator,
-    part0: &[u32],
     input: &[P3],
     n_gid: u32,
     opts: &crate::ParOptions,
 ) -> Result<ParOutput, PassError> {
     let fail_part = opts.fail_part;
-    // Each tet to the lowest part among its points' DDG hosts.
-    let inbox = comm.exchange(send_tets(parts, comm.owned().start, loc, part0));
     // Each part: its points once, by exact key.
     let received = receive_tets(inbox).and_then(|p| match fail_part {
         Some(part) if comm.holds(part) => Err(PassError::Injected { part }),
@@ -207,17 +220,18 @@ fn agreed<C: Comm, T>(comm: &C, r: Result<T, PassError>) -> Result<T, PassError>
     }
 }
 
-/// Each part's tets, addressed to the lowest part among their points' DDG
-/// hosts, one batch per destination (tets in their order).
-fn send_tets(
-    parts: Vec<Part>,
+/// Where each held part's tets go (§8): the lowest part among their
+/// points' DDG hosts in `part0`. The DDG and its locator are not needed
+/// after this.
+pub(crate) fn destinations(
+    parts: &[Part],
     start: usize,
     loc: &Locator,
     part0: &[u32],
-) -> Vec<Vec<(u32, Batch)>> {
+) -> Vec<Vec<u32>> {
     let at_inputs = loc.lowest_at_inputs(part0);
     parts
-        .into_par_iter()
+        .par_iter()
         .enumerate()
         .map(|(i, part)| {
             let k = start + i;
@@ -266,8 +280,7 @@ fn send_tets(
                         .unwrap()
                 })
                 .collect();
-            drop((host, place));
-            batches(&part.pts, &part.gid, &part.tets, &part.tet_pass, &dst)
+            dst
         })
         .collect()
 }
