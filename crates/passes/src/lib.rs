@@ -109,6 +109,15 @@ impl Default for ParOptions {
     }
 }
 
+/// Keeps the entries of `v` whose flag in `gone` is false, in order.
+pub(crate) fn retain_unflagged<T>(v: &mut Vec<T>, gone: &[bool]) {
+    let mut k = 0;
+    v.retain(|_| {
+        k += 1;
+        !gone[k - 1]
+    });
+}
+
 /// Runs the release hook of [`ParOptions::release`], if there is one.
 pub(crate) fn release(hook: Option<fn()>) {
     if let Some(f) = hook {

@@ -51,11 +51,7 @@ pub(super) fn close_pockets(
         }
         i = j;
     }
-    let mut k = 0;
-    res.front.retain(|_| {
-        k += 1;
-        !done[k - 1]
-    });
+    retain_unflagged(&mut res.front, &done);
     made
 }
 

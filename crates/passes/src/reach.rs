@@ -9,18 +9,44 @@ use parafront_geom::{Aabb, P3};
 /// Per cell of a grid over the DDG's box, a bit for each part with a DDG
 /// tet whose box meets the cell.
 pub(crate) struct PartCells {
-    min: P3,
-    /// Cells per unit length, per axis.
-    inv: [f64; 3],
-    n: [usize; 3],
+    grid: Grid,
     /// 64-bit words per cell.
     words: usize,
     bits: Vec<u64>,
 }
 
+/// A grid of `n` cells over a box from `min`.
+struct Grid {
+    min: P3,
+    /// Cells per unit length, per axis.
+    inv: [f64; 3],
+    n: [usize; 3],
+}
+
 /// A box's reach is widened by this share of a cell on each side, so that
 /// two boxes that touch meet in a cell whatever the rounding.
 const SLACK: f64 = 1e-6;
+
+impl Grid {
+    /// The cells `b` meets (clamped to the grid), as cell indices.
+    fn cells(&self, b: &Aabb) -> impl Iterator<Item = usize> + '_ {
+        let at = |k: usize, x: f64, s: f64| {
+            let c = ((x - self.min[k]) * self.inv[k] + s).floor();
+            if c.is_nan() {
+                0
+            } else {
+                c.clamp(0.0, (self.n[k] - 1) as f64) as usize
+            }
+        };
+        let lo = [0, 1, 2].map(|k| at(k, b.min[k], -SLACK));
+        let hi = [0, 1, 2].map(|k| at(k, b.max[k], SLACK));
+        let n = self.n;
+        (lo[0]..=hi[0]).flat_map(move |x| {
+            (lo[1]..=hi[1])
+                .flat_map(move |y| (lo[2]..=hi[2]).map(move |z| (x * n[1] + y) * n[2] + z))
+        })
+    }
+}
 
 impl PartCells {
     /// The cells of `part_of` (DDG tet -> part, `np` parts): about two DDG
@@ -47,57 +73,25 @@ impl PartCells {
                 0.0
             }
         });
-        let mut pc = PartCells {
+        let grid = Grid {
             min: if b.is_empty() { [0.0; 3] } else { b.min },
             inv,
             n,
-            words,
-            bits: vec![0; n[0] * n[1] * n[2] * words],
         };
+        let mut bits = vec![0; n[0] * n[1] * n[2] * words];
         for (t, &k) in part_of.iter().enumerate() {
             let (w, bit) = (k as usize / 64, 1u64 << (k % 64));
-            let (lo, hi) = pc.range(&Aabb::from_points(d.tet_points(t).iter()));
-            for x in lo[0]..=hi[0] {
-                for y in lo[1]..=hi[1] {
-                    for z in lo[2]..=hi[2] {
-                        pc.bits[((x * n[1] + y) * n[2] + z) * words + w] |= bit;
-                    }
-                }
+            for c in grid.cells(&Aabb::from_points(d.tet_points(t).iter())) {
+                bits[c * words + w] |= bit;
             }
         }
-        pc
-    }
-
-    fn range(&self, b: &Aabb) -> ([usize; 3], [usize; 3]) {
-        let at = |k: usize, x: f64, s: f64| {
-            let c = ((x - self.min[k]) * self.inv[k] + s).floor();
-            if c.is_nan() {
-                0
-            } else {
-                c.clamp(0.0, (self.n[k] - 1) as f64) as usize
-            }
-        };
-        (
-            [0, 1, 2].map(|k| at(k, b.min[k], -SLACK)),
-            [0, 1, 2].map(|k| at(k, b.max[k], SLACK)),
-        )
+        PartCells { grid, words, bits }
     }
 
     /// Whether box `b` meets a cell of part `k`.
     pub(crate) fn meets(&self, k: u32, b: &Aabb) -> bool {
         let (w, bit) = (k as usize / 64, 1u64 << (k % 64));
-        let (lo, hi) = self.range(b);
-        for x in lo[0]..=hi[0] {
-            for y in lo[1]..=hi[1] {
-                for z in lo[2]..=hi[2] {
-                    let c = (x * self.n[1] + y) * self.n[2] + z;
-                    if self.bits[c * self.words + w] & bit != 0 {
-                        return true;
-                    }
-                }
-            }
-        }
-        false
+        (self.grid.cells(b)).any(|c| self.bits[c * self.words + w] & bit != 0)
     }
 }
 

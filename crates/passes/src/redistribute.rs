@@ -469,29 +469,28 @@ fn on_boundary(pc: &Piece) -> Vec<u32> {
         // Three 21-bit ids in a word: two thirds of the sort's memory.
         let pack = |v: [u32; 3]| u64::from(v[0]) | u64::from(v[1]) << 21 | u64::from(v[2]) << 42;
         let unpack = |w: u64| [0, 21, 42].map(|s| ((w >> s) & 0x1f_ffff) as u32);
-        let mut faces: Vec<u64> = (pc.tets.iter())
-            .flat_map(|t| FACES.map(|f| pack(sorted(t, f))))
-            .collect();
-        faces.sort_unstable();
-        for run in faces.chunk_by(|a, b| a == b) {
-            if run.len() == 1 {
-                mark(unpack(run[0]));
-            }
-        }
+        let faces = pc
+            .tets
+            .iter()
+            .flat_map(|t| FACES.map(|f| pack(sorted(t, f))));
+        each_once(faces.collect(), |w| mark(unpack(w)));
     } else {
-        let mut faces: Vec<[u32; 3]> = (pc.tets.iter())
-            .flat_map(|t| FACES.map(|f| sorted(t, f)))
-            .collect();
-        faces.sort_unstable();
-        for run in faces.chunk_by(|a, b| a == b) {
-            if run.len() == 1 {
-                mark(run[0]);
-            }
-        }
+        let faces = pc.tets.iter().flat_map(|t| FACES.map(|f| sorted(t, f)));
+        each_once(faces.collect(), mark);
     }
     (0..pc.points.len() as u32)
         .filter(|&i| outer[i as usize])
         .collect()
+}
+
+/// Calls `f` with each key that occurs only once in `keys`.
+fn each_once<K: Ord + Copy>(mut keys: Vec<K>, mut f: impl FnMut(K)) {
+    keys.sort_unstable();
+    for run in keys.chunk_by(|a, b| a == b) {
+        if let [k] = run {
+            f(*k);
+        }
+    }
 }
 
 /// Renumber the pieces' global point ids densely; the count.

@@ -112,11 +112,7 @@ fn cancel_across<C: Comm>(parts: &mut [Part], comm: &C) {
                     drop[sent[j as usize] as usize] = true;
                 }
             }
-            let mut k = 0;
-            part.front.retain(|_| {
-                k += 1;
-                !drop[k - 1]
-            });
+            retain_unflagged(&mut part.front, &drop);
         });
 }
 
@@ -189,11 +185,7 @@ pub(super) fn local_front(faces: impl Iterator<Item = [Rec; 3]>) -> (FrontInput,
 /// Cancels opposite pairs of faces (the hole on both sides).
 pub(super) fn cancel_pairs(hole: &mut Vec<[Rec; 3]>) {
     let gone = cancelled(hole.len(), |i| hole[i].map(|r| r.gid));
-    let mut k = 0;
-    hole.retain(|_| {
-        k += 1;
-        !gone[k - 1]
-    });
+    retain_unflagged(hole, &gone);
 }
 
 /// Which of `n` faces (global ids of face `i`: `gids(i)`) cancel: sorted
