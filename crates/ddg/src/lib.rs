@@ -15,7 +15,7 @@ mod partition;
 pub use field::GradedField;
 
 pub use filter::{Interfaces, PartFilter};
-pub use locate::Locator;
+pub use locate::{Locator, SHARED_PER_CELL};
 pub use partition::{
     components, cut_faces, cut_fine_faces, imbalance, order_for_shift, partition, rcb, shift_loads,
     shifted, tet_weights, Partition, Shift,

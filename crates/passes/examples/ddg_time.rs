@@ -51,7 +51,7 @@ fn main() {
                             let _ = g::shifted(&d, &p0, g::Shift::FromHigher, 2);
                             let _ = g::shifted(&d, &p0, g::Shift::FromLower, 2);
                             let t4 = t0.elapsed().as_secs_f64();
-                            let _ = g::Interfaces::new(&d, &p0);
+                            let _ = g::Interfaces::new(&d, &p0, 0..parts as u32);
                             let t5 = t0.elapsed().as_secs_f64();
                             let mut n = 0usize;
                             for &p in &d.points {

@@ -471,7 +471,7 @@ pub fn mesh_parallel_around<C: Comm>(
     )?;
     rec.ddg(&d, built, t_ddg.elapsed().as_secs_f64());
     // §6 step 2: weights and the balanced split.
-    let (loc, w, base) = split_ddg(&d, size, opts, np, &mut rec);
+    let (loc, base) = split_ddg(&d, size, opts, (np, comm.owned().len() < np), &mut rec);
     // The DDG's build leaves its fronts' memory free in the allocator's
     // heaps; a process's peak comes later, in pass 1.
     release(opts.release);
@@ -502,7 +502,6 @@ pub fn mesh_parallel_around<C: Comm>(
     let passes = Passes {
         d: &d,
         loc: &loc,
-        w: &w,
         size,
         opts,
         comm,
@@ -531,6 +530,8 @@ pub fn mesh_parallel_around<C: Comm>(
         opts.fill_after,
     )?;
     rec.pass4(made4, removed, t0.elapsed().as_secs_f64());
+    // Pass 4's front is freed: returned before redistribution's lists.
+    release(opts.release);
     debug_check_parts(&parts, "pass 4");
 
     // §8 step 4.
@@ -540,7 +541,7 @@ pub fn mesh_parallel_around<C: Comm>(
     // The DDG, its locator and its partitions are done with before the
     // tets move: they were 30 MB of each MPI rank's peak on sphere_5e6,
     // which redistribution set.
-    drop((on, loc, w));
+    drop((on, loc));
     drop(d);
     release(opts.release);
     let sent = redistribute::send(parts, dst, comm);
@@ -600,15 +601,18 @@ fn the_ddg<C: Comm>(
     Ok((d, None))
 }
 
-/// §6 step 2: the DDG's locator, its tet weights and the balanced split
-/// into `np` parts, with their statistics.
+/// §6 step 2: the DDG's locator and the balanced split into `np` parts,
+/// with their statistics; coarser bins where the process holds only
+/// some of the parts (`shared`). The tet weights are not kept: the crossing
+/// partition computes them again (1.6 MB of each MPI rank through the
+/// passes on sphere_5e6 at 32 parts).
 fn split_ddg<'d>(
     d: &'d Ddg,
     size: &(dyn Fn(P3) -> f64 + Sync),
     opts: &ParOptions,
-    np: usize,
+    (np, shared): (usize, bool),
     rec: &mut Recorder,
-) -> (Locator<'d>, Vec<f64>, Vec<u32>) {
+) -> (Locator<'d>, Vec<u32>) {
     let st = &mut rec.st;
     let t0 = Instant::now();
     let w = ddg::tet_weights(d, size);
@@ -618,7 +622,11 @@ fn split_ddg<'d>(
     let t_split = t1.elapsed().as_secs_f64();
     // The locator after METIS, not beside it: METIS's work space is gone
     // by then (on sphere_5e6 both together set each MPI rank's peak).
-    let loc = Locator::new(d);
+    let loc = if shared {
+        Locator::with_bins(d, ddg::SHARED_PER_CELL)
+    } else {
+        Locator::new(d)
+    };
     st.split_seconds = t_split;
     let t_rcb = t0.elapsed().as_secs_f64();
     st.predicted_imbalance = ddg::imbalance(&part0, &w, np);
@@ -637,7 +645,7 @@ fn split_ddg<'d>(
             loc.heap_bytes() as f64 * 1e-6
         );
     }
-    (loc, w, part0)
+    (loc, part0)
 }
 
 /// How the passes' fronts size new tets: the field, and the tallest tet

@@ -244,7 +244,6 @@ pub(super) fn absorb_local(part: &mut Part, m: Made, pass: u8) -> Absorbed {
     part.pts.reserve_exact(n_new);
     part.size.reserve_exact(n_new);
     part.gid.reserve_exact(n_new);
-    part.index.reserve(n_new);
     let ok = |i: u32| (i as usize) >= n_in || m.input_ok[i as usize];
     let kept = |f: &[u32; 3]| f.iter().all(|&i| ok(i));
     // Only the input points a tet or a kept face names join the part: the
@@ -296,8 +295,7 @@ pub(super) fn absorb_local(part: &mut Part, m: Made, pass: u8) -> Absorbed {
         part.tets.reserve_exact(n);
         part.tets.extend(mapped);
     }
-    part.tet_pass.reserve_exact(n);
-    part.tet_pass.resize(part.tet_pass.len() + n, pass);
+    part.tet_pass.push_n(pass, n);
     Absorbed {
         first_new,
         new_points: n_new as u32,
@@ -311,10 +309,9 @@ pub(super) fn absorb_local(part: &mut Part, m: Made, pass: u8) -> Absorbed {
 /// faces' points theirs.
 pub(super) fn absorb_finish(part: &mut Part, a: &Absorbed, base: u32) {
     for k in 0..a.new_points {
-        let l = a.first_new + k;
-        part.gid[l as usize] = base + k;
-        part.index.insert(base + k, l);
+        part.gid[(a.first_new + k) as usize] = base + k;
     }
+    part.index.insert_run(base, a.first_new, a.new_points);
     part.stuck
         .extend(a.stuck.iter().map(|&l| part.gid[l as usize]));
 }
@@ -382,7 +379,7 @@ mod absorb_tests {
         assert_eq!(part.tets, vec![[0, 1, 2, 4]]);
         assert_eq!(part.front, vec![[2, 3, 4]]);
         assert_eq!(part.stuck, vec![103, 104, 500]);
-        assert_eq!(part.tet_pass, vec![2]);
+        assert_eq!(part.tet_pass.to_vec(), vec![2]);
         part.check().expect("a sound part");
     }
 }

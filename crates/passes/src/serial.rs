@@ -135,8 +135,11 @@ pub(super) fn remove_touching(
     const INWARD: [[usize; 3]; 4] = [[1, 3, 2], [0, 2, 3], [0, 3, 1], [0, 1, 2]];
     let mut out = Vec::new();
     let mut kept = 0;
+    let passes = std::mem::take(&mut part.tet_pass);
+    let mut pass = passes.iter();
     for t in 0..part.tets.len() {
         let tv = part.tets[t];
+        let p = pass.next().unwrap_or(0);
         let hits = tv
             .iter()
             .filter(|&&i| marked.contains(&part.gid[i as usize]))
@@ -145,13 +148,12 @@ pub(super) fn remove_touching(
             out.extend(INWARD.map(|f| f.map(|c| tv[c])));
         } else {
             part.tets[kept] = tv;
-            part.tet_pass[kept] = part.tet_pass[t];
+            part.tet_pass.push_n(p, 1);
             kept += 1;
         }
     }
     let removed = part.tets.len() - kept;
     part.tets.truncate(kept);
-    part.tet_pass.truncate(kept);
     (removed, out)
 }
 
@@ -462,7 +464,7 @@ mod tests {
         };
         let tets: Vec<[u32; 4]> = tets.iter().map(|t| t.map(&mut local)).collect();
         let front: Vec<[u32; 3]> = front.iter().map(|f| f.map(&mut local)).collect();
-        p.tet_pass = vec![1; tets.len()];
+        p.tet_pass.push_n(1, tets.len());
         (p.tets, p.front, p.stuck) = (tets, front, stuck.to_vec());
         p
     }
@@ -524,6 +526,30 @@ mod tests {
                 assert_eq!(p.check(), Ok(()));
             }
         }
+    }
+
+    /// The kept tets keep their order and their passes.
+    #[test]
+    fn removing_tets_keeps_the_others_passes() {
+        let pts: Vec<P3> = (0..8).map(|i| [i as f64, (i * i) as f64, 0.0]).collect();
+        let tets = [[0, 1, 2, 3], [1, 2, 3, 4], [2, 3, 4, 5], [4, 5, 6, 7]];
+        let mut p = part(&pts, &tets, &[], &[]);
+        p.tet_pass = TetPasses::default();
+        for pass in [1, 2, 2, 3] {
+            p.tet_pass.push_n(pass, 1);
+        }
+        // Points 0 and 1 mark the first tet; 6 and 7 the last.
+        let marked: rustc_hash::FxHashSet<u32> = [0, 1, 6, 7].into_iter().collect();
+        let (removed, faces) = remove_touching(&mut p, &marked, 2);
+        assert_eq!((removed, faces.len()), (2, 8));
+        let kept: Vec<[u32; 4]> = p
+            .tets
+            .iter()
+            .map(|t| t.map(|i| p.gid[i as usize]))
+            .collect();
+        assert_eq!(kept, vec![[1, 2, 3, 4], [2, 3, 4, 5]]);
+        assert_eq!(p.tet_pass.to_vec(), vec![2, 2]);
+        assert_eq!(p.check(), Ok(()));
     }
 
     #[test]

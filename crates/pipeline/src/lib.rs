@@ -413,6 +413,8 @@ fn mesh_surface_here<C: Comm>(
     };
     sum.voided_shells = voided;
     let fronts = material_regions(s, &report.shells);
+    // Its shells' lists are in the fronts now: not held through the passes.
+    drop(report);
     sum.push(Stage::Validate, t0.elapsed().as_secs_f64());
 
     let t0 = Instant::now();
