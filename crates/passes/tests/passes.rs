@@ -357,9 +357,10 @@ fn count_release() {
     RELEASED.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
 }
 
-/// The release hook runs once after the DDG's split, once after each
-/// part's front in each fine pass, once after each pass's peel and once
-/// after pass 4, and leaves the mesh as it is.
+/// The release hook runs once after the DDG's split, before and after
+/// each part's front in each fine pass (before only where the part has
+/// faces to advance), once after each pass's peel and once after pass 4,
+/// and leaves the mesh as it is.
 #[test]
 fn the_release_hook_runs_between_fronts_and_changes_nothing() {
     let s = generate::icosphere([0.0; 3], 1.0, 3);
@@ -376,10 +377,10 @@ fn the_release_hook_runs_between_fronts_and_changes_nothing() {
     let hooked = go(Some(count_release));
     let n = RELEASED.load(std::sync::atomic::Ordering::Relaxed);
     // After the split, pass 4 and once the DDG is dropped
-    // (redistribution), and for 4 parts and the peel in at least passes 1
-    // to 3.
+    // (redistribution), and for 4 parts (twice where they advance) and
+    // the peel in at least passes 1 to 3.
     assert!(n >= 3 + 3 * 5, "released {n} times");
-    assert_eq!(n % 5, 3, "released {n} times: 3 times, then 5 a pass");
+    assert!(n <= 3 + 6 * 9, "released {n} times");
     assert_eq!(plain.tets, hooked.tets);
     assert_eq!(bits(&plain.points), bits(&hooked.points));
     check(&s, &hooked);
