@@ -112,16 +112,11 @@ pub(crate) fn parallel_pass<C: Comm>(
     if let Some(first) = local.first_mut() {
         *first = sent;
     }
-    let inputs = comm.all_reduce(local, |mut a, b| {
-        if a.len() < b.len() {
-            return b
-                .iter()
-                .zip(a.iter().chain(std::iter::repeat(&0)))
-                .map(|(x, y)| x + y)
-                .collect();
-        }
-        a.iter_mut().zip(&b).for_each(|(x, y)| *x += y);
-        a
+    // Every list is `np` long or empty: the longer one takes the sum.
+    let inputs = comm.all_reduce(local, |a, b| {
+        let (mut long, short) = if a.len() >= b.len() { (a, b) } else { (b, a) };
+        long.iter_mut().zip(&short).for_each(|(x, y)| *x += y);
+        long
     });
     let mut order: Vec<usize> = (0..parts.len()).collect();
     order.sort_by_key(|&i| (std::cmp::Reverse(inputs[start + i]), i));

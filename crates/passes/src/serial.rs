@@ -139,7 +139,7 @@ pub(super) fn remove_touching(
     let mut pass = passes.iter();
     for t in 0..part.tets.len() {
         let tv = part.tets[t];
-        let p = pass.next().unwrap_or(0);
+        let p = pass.next().expect("a pass for every tet");
         let hits = tv
             .iter()
             .filter(|&&i| marked.contains(&part.gid[i as usize]))

@@ -2,10 +2,8 @@
 //! mesher on each region, its parts' messages through a `Comm`, and the end
 //! of a partitioned run whose mesh stays in its pieces.
 use super::*;
-use parafront_geom::P3;
 use parafront_lattice::Lattice;
 use parafront_passes::{move_pieces, Piece};
-use std::borrow::Cow;
 
 /// The parallel mesher (§5 to §8, `parallel`: `mesh_parallel`, or one
 /// that fails in tests) on each region, its parts' messages through
@@ -51,15 +49,7 @@ pub(crate) fn mesh_parts<C: Comm>(
     // Seconds of each of `Stage::PARALLEL`, summed over the regions.
     let mut stage = [0.0f64; Stage::PARALLEL.len()];
     for rf in fronts {
-        // A region bounded by the whole surface (ids ascending, distinct)
-        // reads the surface's points and sizes in place: their copies were
-        // 1.9 MB of each MPI rank through the passes on sphere_5e6.
-        let (mut pts, mut hs): (Cow<[P3]>, Cow<[f64]>) = if rf.points.len() == s.points.len() {
-            (s.points[..].into(), sizing.surface_point_sizes().into())
-        } else {
-            let (p, h) = region_points(s, sizing, rf);
-            (p.into(), h.into())
-        };
+        let (mut pts, mut hs) = region_points(s, sizing, rf);
         // The lattice fills the core; the passes mesh the layer between it
         // and the surface.
         let n_in = pts.len() as u32;
