@@ -169,7 +169,9 @@ pub(crate) struct MeshArgs {
     pub(crate) optimize: Option<u8>,
     /// Parts the improvement runs on in parallel (§9.5), interfaces
     /// frozen, then a second pass on shifted parts: 0 (default) one part
-    /// per 100k tets, 1 serial. The mesh depends on it, not on --threads.
+    /// per 100k tets of a merged mesh, and each piece of a partitioned one
+    /// (--parts) as one part; 1 serial. The mesh depends on it, not on
+    /// --threads.
     #[arg(long)]
     pub(crate) optimize_parts: Option<usize>,
     /// Recovery rounds of a stalled front before the constrained fill

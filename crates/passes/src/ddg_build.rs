@@ -418,7 +418,12 @@ pub(crate) fn build_ddg_at<C: Comm>(
     // Every process gets every part's tets (the DDG is replicated: each
     // locates points in all of it), in part order, so the merge is the
     // same bytes everywhere.
-    let all = comm.all_gather(parts.into_iter().map(|p| (p.gid, p.pts, p.tets)).collect());
+    let all = comm.all_gather(
+        parts
+            .into_iter()
+            .map(|p| (p.gid, p.pts, p.tets.to_vec()))
+            .collect(),
+    );
     let (pts, tets, neigh) = merge_parts(all, points.len(), next_gid as usize)?;
     st.merge_seconds = t0.elapsed().as_secs_f64();
     Ok((

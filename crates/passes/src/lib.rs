@@ -18,6 +18,7 @@
 
 mod check;
 mod ddg_build;
+mod packed;
 mod part;
 mod pass;
 mod pockets;

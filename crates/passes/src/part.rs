@@ -1,5 +1,6 @@
 //! One part of the passes (§7): the records its messages carry, its
 //! local points, tets and front, and what one front call gave back.
+pub(crate) use crate::packed::PackedTets;
 use parafront_comm::{Wire, WireError};
 use parafront_geom::P3;
 use rustc_hash::FxHashMap;
@@ -143,7 +144,7 @@ pub(crate) struct Part {
     pub(crate) gid: Vec<u32>,
     pub(crate) index: Index,
     /// Local ids.
-    pub(crate) tets: Vec<[u32; 4]>,
+    pub(crate) tets: PackedTets,
     pub(crate) tet_pass: TetPasses,
     /// The faces this part holds, local ids.
     pub(crate) front: Vec<[u32; 3]>,
@@ -188,11 +189,11 @@ pub(crate) fn add_core_tets(
     core_tets: &[Vec<[u32; 4]>],
 ) {
     for (part, block) in parts.iter_mut().zip(core_tets) {
-        part.tets.reserve_exact(block.len());
-        for t in block {
-            let v = t.map(|i| part.local_input(i, (points, point_size)));
-            part.tets.push(v);
-        }
+        let local: Vec<[u32; 4]> = block
+            .iter()
+            .map(|t| t.map(|i| part.local_input(i, (points, point_size))))
+            .collect();
+        part.tets.extend(local);
         part.tet_pass.push_n(0, block.len());
     }
 }
@@ -244,7 +245,7 @@ impl Part {
             v.iter().any(|&i| i as usize >= n)
                 || (0..v.len()).any(|a| (a + 1..v.len()).any(|b| v[a] == v[b]))
         };
-        if let Some(t) = self.tets.iter().position(|t| bad(t)) {
+        if let Some(t) = self.tets.iter().position(|t| bad(&t)) {
             return Err(PartCheckError::Tet(t));
         }
         if let Some(f) = self.front.iter().position(|f| bad(f)) {
@@ -315,15 +316,16 @@ mod part_check_tests {
                 })
             })
             .collect();
-        p.tets.push([ids[0], ids[1], ids[2], ids[3]]);
+        let tet = |last: u32| PackedTets::from_iter([[ids[0], ids[1], ids[2], last]]);
+        p.tets = tet(ids[3]);
         p.tet_pass.push_n(1, 1);
         p.front.push([ids[0], ids[2], ids[1]]);
         assert_eq!(p.check(), Ok(()));
-        p.tets[0][3] = ids[0];
+        p.tets = tet(ids[0]);
         assert_eq!(p.check(), Err(PartCheckError::Tet(0)));
-        p.tets[0][3] = 9;
+        p.tets = tet(9);
         assert_eq!(p.check(), Err(PartCheckError::Tet(0)));
-        p.tets[0][3] = ids[3];
+        p.tets = tet(ids[3]);
         p.front[0][1] = 7;
         assert_eq!(p.check(), Err(PartCheckError::Face(0)));
         p.front[0][1] = ids[2];

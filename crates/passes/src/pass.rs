@@ -439,7 +439,7 @@ pub(crate) fn seed_inner_parts(
                 h: size(v[i]),
             })
         });
-        part.tets.push(ids);
+        part.tets.extend([ids]);
         part.tet_pass.push_n(1, 1);
         for f in OUTWARD {
             part.front.push(f.map(|i| ids[i]));

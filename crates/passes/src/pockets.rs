@@ -287,14 +287,8 @@ pub(super) fn absorb_local(part: &mut Part, m: Made, pass: u8) -> Absorbed {
         }
     }
     let n = r.tets.len();
-    let mapped = r.tets.into_iter().map(|t| t.map(|i| map[i as usize]));
-    if part.tets.is_empty() {
-        // In place: no second copy of the part's tets.
-        part.tets = mapped.collect();
-    } else {
-        part.tets.reserve_exact(n);
-        part.tets.extend(mapped);
-    }
+    part.tets
+        .extend(r.tets.into_iter().map(|t| t.map(|i| map[i as usize])));
     part.tet_pass.push_n(pass, n);
     Absorbed {
         first_new,
@@ -376,7 +370,7 @@ mod absorb_tests {
         absorb_finish(&mut part, &a, 500);
         assert_eq!(part.gid, vec![100, 102, 103, 104, 500]);
         assert_eq!(part.pts, [0, 2, 3, 4, 6].map(p).to_vec());
-        assert_eq!(part.tets, vec![[0, 1, 2, 4]]);
+        assert_eq!(part.tets.to_vec(), vec![[0, 1, 2, 4]]);
         assert_eq!(part.front, vec![[2, 3, 4]]);
         assert_eq!(part.stuck, vec![103, 104, 500]);
         assert_eq!(part.tet_pass.to_vec(), vec![2]);

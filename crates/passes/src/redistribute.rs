@@ -3,7 +3,7 @@
 //! coordinate keys, points and tets get global numbers, and each part
 //! learns its neighbours and the points it shares with each (bounding-box
 //! overlap first, then an exact match).
-use crate::{ParOutput, Part, PassError};
+use crate::{PackedTets, ParOutput, Part, PassError};
 use parafront_comm::{Comm, Wire, WireError};
 use parafront_ddg::Locator;
 use parafront_geom::{Aabb, P3};
@@ -46,13 +46,15 @@ fn key(p: P3) -> Key {
 type Keyed = (Piece, Vec<u32>);
 
 /// The tets one part sends another: their points once each (global id,
-/// where it is), then the tets by global ids and the pass that made each.
-/// A tet as four located points was 113 bytes, most of the peak memory of
-/// a run on parts.
+/// where it is), then the tets by global ids, packed, and the pass that
+/// made each. A tet as four located points was 113 bytes, most of the
+/// peak memory of a run on parts; as four ids, 16 bytes (the batches of a
+/// process's parts are all made before they are sent: 14 MB of an MPI
+/// rank's peak on sphere_5e6 at 32 parts, 4 ranks).
 #[derive(Default)]
 struct Batch {
     points: Vec<(u32, P3)>,
-    tets: Vec<[u32; 4]>,
+    tets: PackedTets,
     pass: Vec<u8>,
 }
 
@@ -77,7 +79,8 @@ pub(crate) fn send<C: Comm>(parts: Vec<Part>, dests: Vec<Dests>, comm: &C) -> Se
         .map(|(part, dests)| {
             let dst = dests.expand(part.tets.len());
             let pass = part.tet_pass.to_vec();
-            batches(&part.pts, &part.gid, &part.tets, &pass, &dst)
+            let tets = part.tets.to_vec();
+            batches(&part.pts, &part.gid, &tets, &pass, (&dst, None))
         })
         .collect();
     Sent(comm.exchange(out))
@@ -165,44 +168,100 @@ pub(crate) fn finish<C: Comm>(
 /// and their shared lists found again. Global point ids stay.
 pub fn shift_pieces<C: Comm>(comm: &C, pieces: Vec<Piece>) -> Result<Vec<Piece>, PassError> {
     let start = comm.owned().start;
-    let dst = pieces
-        .par_iter()
-        .enumerate()
-        .map(|(i, pc)| {
-            let k = (start + i) as u32;
-            let mut low = vec![k; pc.points.len()];
-            for (&q, list) in pc.neighbours.iter().zip(&pc.shared) {
-                for &j in list {
-                    low[j as usize] = low[j as usize].min(q);
-                }
+    move_pieces(comm, pieces, |i, pc| {
+        let k = (start + i) as u32;
+        let mut low = vec![k; pc.points.len()];
+        for (&q, list) in pc.neighbours.iter().zip(&pc.shared) {
+            for &j in list {
+                low[j as usize] = low[j as usize].min(q);
             }
-            pc.tets
-                .iter()
-                .map(|t| t.iter().map(|&j| low[j as usize]).min().unwrap_or(k))
-                .collect()
-        })
-        .collect();
-    move_pieces(comm, pieces, dst)
+        }
+        pc.tets
+            .iter()
+            .map(|t| t.iter().map(|&j| low[j as usize]).min().unwrap_or(k))
+            .collect()
+    })
 }
 
-/// Every tet of the pieces this process holds goes to the part `dst`
-/// gives it (per piece, per tet); the pieces are rebuilt as in
-/// [`shift_pieces`]. Global point ids stay.
+/// Every tet of the pieces this process holds goes to the part
+/// `dst(i, piece)` gives it (for `pieces[i]`, per tet; empty for a piece
+/// with none); the pieces are rebuilt as in [`shift_pieces`]. Global point
+/// ids stay. Each piece's destinations are made as it is sent: all of them
+/// at once were 21 MB of a single process's peak (sphere_5e6 at `--parts
+/// 32`, its largest moment). Only the tets that leave a piece are sent;
+/// those that stay keep their place (a piece's tets sent to itself were a
+/// copy of it, 5 MB of an MPI rank's peak on sphere_5e6).
 pub fn move_pieces<C: Comm>(
     comm: &C,
     pieces: Vec<Piece>,
-    dst: Vec<Vec<u32>>,
+    dst: impl Fn(usize, &Piece) -> Vec<u32> + Sync,
 ) -> Result<Vec<Piece>, PassError> {
-    let out: Vec<Vec<(u32, Batch)>> = pieces
+    let start = comm.owned().start;
+    let (out, kept): (Vec<Vec<(u32, Batch)>>, Vec<Piece>) = pieces
         .into_par_iter()
-        .zip(dst)
-        .map(|(pc, dst)| batches(&pc.points, &pc.gid, &pc.tets, &pc.tet_pass, &dst))
-        .collect();
+        .enumerate()
+        .map(|(i, mut pc)| {
+            let k = (start + i) as u32;
+            let dst = dst(i, &pc);
+            debug_assert!(dst.len() == pc.tets.len() || pc.tets.is_empty());
+            let out = batches(&pc.points, &pc.gid, &pc.tets, &pc.tet_pass, (&dst, Some(k)));
+            let mut stay = dst.iter().map(|&d| d == k);
+            pc.tets.retain(|_| stay.next().unwrap_or(true));
+            let mut stay = dst.iter().map(|&d| d == k);
+            pc.tet_pass.retain(|_| stay.next().unwrap_or(true));
+            (out, pc)
+        })
+        .unzip();
     let inbox = comm.exchange(out);
-    let mut pieces = agreed(comm, receive_tets(inbox))?;
+    let joined = kept
+        .into_par_iter()
+        .zip(inbox)
+        .enumerate()
+        .map(|(i, (pc, msgs))| join(pc, msgs, (start + i) as u32))
+        .collect::<Result<Vec<Keyed>, PassError>>();
+    let mut pieces = agreed(comm, joined)?;
     number_tets(comm, &mut pieces);
     share_points(comm, &mut pieces);
     Ok(pieces.into_iter().map(|p| p.0).collect())
+}
+
+/// Piece `k` from the tets it kept and those it received (`msgs`, by
+/// sending part ascending): the lower parts' tets, its own, the higher
+/// parts', with the points once each in the order the tets first use them
+/// (as [`receive_tets`] would make it from batches of all of them). Its own
+/// tets are renumbered in place.
+fn join(pc: Piece, msgs: Vec<(u32, Batch)>, k: u32) -> Result<Keyed, PassError> {
+    let Piece {
+        points,
+        gid,
+        tets: mut own,
+        tet_pass: own_pass,
+        ..
+    } = pc;
+    let mut out = Piece::default();
+    let mut local: FxHashMap<u32, u32> = FxHashMap::default();
+    let (lower, higher): (Vec<_>, Vec<_>) = msgs.into_iter().partition(|m| m.0 < k);
+    add_batches(&mut out, &mut local, lower);
+    for t in &mut own {
+        *t = t.map(|j| {
+            let g = gid[j as usize];
+            *local.entry(g).or_insert_with(|| {
+                out.points.push(points[j as usize]);
+                out.gid.push(g);
+                out.points.len() as u32 - 1
+            })
+        });
+    }
+    drop((points, gid));
+    if out.tets.is_empty() {
+        (out.tets, out.tet_pass) = (own, own_pass);
+    } else {
+        out.tets.reserve_exact(own.len());
+        out.tets.extend(own);
+        out.tet_pass.extend(own_pass);
+    }
+    add_batches(&mut out, &mut local, higher);
+    keyed(out)
 }
 
 /// `r` once every process knows whether each succeeded: an error here
@@ -329,22 +388,26 @@ impl Dests {
 }
 
 /// The tets (local ids into `pts` and `gid`) as one batch per destination
-/// `dst[t]`, ascending, each in tet order with its points once.
+/// `dst[t]`, ascending, each in tet order with its points once; none for
+/// the destination `skip`.
 fn batches(
     pts: &[P3],
     gid: &[u32],
     tets: &[[u32; 4]],
     pass: &[u8],
-    dst: &[u32],
+    (dst, skip): (&[u32], Option<u32>),
 ) -> Vec<(u32, Batch)> {
     // By destination, each in tet order (a stable sort).
-    let mut order: Vec<u32> = (0..tets.len() as u32).collect();
+    let mut order: Vec<u32> = (0..dst.len() as u32)
+        .filter(|&t| Some(dst[t as usize]) != skip)
+        .collect();
     order.sort_by_key(|&t| dst[t as usize]);
     let mut stamp = vec![u32::MAX; pts.len()];
     let mut out = Vec::new();
     for group in order.chunk_by(|&a, &b| dst[a as usize] == dst[b as usize]) {
         let d = dst[group[0] as usize];
         let mut b = Batch::default();
+        let mut by_gid = Vec::with_capacity(group.len());
         for &t in group {
             let tv = tets[t as usize];
             for &p in &tv {
@@ -353,9 +416,10 @@ fn batches(
                     b.points.push((gid[p as usize], pts[p as usize]));
                 }
             }
-            b.tets.push(tv.map(|p| gid[p as usize]));
+            by_gid.push(tv.map(|p| gid[p as usize]));
             b.pass.push(pass[t as usize]);
         }
+        b.tets = by_gid.into_iter().collect();
         out.push((d, b));
     }
     out
@@ -368,28 +432,42 @@ fn receive_tets(inbox: Vec<Vec<(u32, Batch)>>) -> Result<Vec<Keyed>, PassError> 
         .into_par_iter()
         .map(|msgs| {
             let mut pc = Piece::default();
-            let mut local: FxHashMap<u32, u32> = FxHashMap::default();
-            for (_, b) in msgs {
-                let at: FxHashMap<u32, u32> = (b.points.iter().enumerate())
-                    .map(|(i, p)| (p.0, i as u32))
-                    .collect();
-                for (tv, pass) in b.tets.into_iter().zip(b.pass) {
-                    let t = tv.map(|g| {
-                        *local.entry(g).or_insert_with(|| {
-                            pc.points.push(b.points[at[&g] as usize].1);
-                            pc.gid.push(g);
-                            pc.points.len() as u32 - 1
-                        })
-                    });
-                    pc.tets.push(t);
-                    pc.tet_pass.push(pass);
-                }
-            }
-            drop(local);
-            let by_key = by_key(&pc)?;
-            Ok((pc, by_key))
+            add_batches(&mut pc, &mut FxHashMap::default(), msgs);
+            keyed(pc)
         })
         .collect::<Result<_, PassError>>()
+}
+
+/// The batches' tets added to `pc` (room made once), their points once
+/// each (`local`: the piece's local id of each global id it has).
+fn add_batches(pc: &mut Piece, local: &mut FxHashMap<u32, u32>, msgs: Vec<(u32, Batch)>) {
+    let n: usize = msgs.iter().map(|(_, b)| b.tets.len()).sum();
+    pc.tets.reserve_exact(n);
+    pc.tet_pass.reserve_exact(n);
+    for (_, b) in msgs {
+        let at: FxHashMap<u32, u32> = (b.points.iter().enumerate())
+            .map(|(i, p)| (p.0, i as u32))
+            .collect();
+        for (tv, pass) in b.tets.iter().zip(b.pass) {
+            let t = tv.map(|g| {
+                *local.entry(g).or_insert_with(|| {
+                    pc.points.push(b.points[at[&g] as usize].1);
+                    pc.gid.push(g);
+                    pc.points.len() as u32 - 1
+                })
+            });
+            pc.tets.push(t);
+            pc.tet_pass.push(pass);
+        }
+    }
+}
+
+/// A piece made, with its points' order by key.
+fn keyed(mut pc: Piece) -> Result<Keyed, PassError> {
+    pc.points.shrink_to_fit();
+    pc.gid.shrink_to_fit();
+    let by_key = by_key(&pc)?;
+    Ok((pc, by_key))
 }
 
 /// The piece's points in the order of their exact keys, or the first two
@@ -500,6 +578,11 @@ fn share_points<C: Comm>(comm: &C, pieces: &mut [Keyed]) {
 /// all its tets there. Sending every point in a neighbour's box instead
 /// was 30 MB of each MPI rank's peak (sphere_5e6, 4 ranks, 32 parts).
 fn on_boundary(pc: &Piece) -> Vec<u32> {
+    on_boundary_in(pc, BOUNDARY_BAND)
+}
+
+/// [`on_boundary`] sorting about `band` faces at once.
+fn on_boundary_in(pc: &Piece, band: usize) -> Vec<u32> {
     const FACES: [[usize; 3]; 4] = [[0, 1, 2], [0, 1, 3], [0, 2, 3], [1, 2, 3]];
     let mut outer = vec![false; pc.points.len()];
     let mut mark = |f: [u32; 3]| f.iter().for_each(|&i| outer[i as usize] = true);
@@ -508,23 +591,37 @@ fn on_boundary(pc: &Piece) -> Vec<u32> {
         v.sort_unstable();
         v
     };
-    if pc.points.len() < 1 << 21 {
-        // Three 21-bit ids in a word: two thirds of the sort's memory.
-        let pack = |v: [u32; 3]| u64::from(v[0]) | u64::from(v[1]) << 21 | u64::from(v[2]) << 42;
-        let unpack = |w: u64| [0, 21, 42].map(|s| ((w >> s) & 0x1f_ffff) as u32);
-        let faces = pc
-            .tets
+    let faces = || {
+        pc.tets
             .iter()
-            .flat_map(|t| FACES.map(|f| pack(sorted(t, f))));
-        each_once(faces.collect(), |w| mark(unpack(w)));
-    } else {
-        let faces = pc.tets.iter().flat_map(|t| FACES.map(|f| sorted(t, f)));
-        each_once(faces.collect(), mark);
+            .flat_map(move |t| FACES.map(|f| sorted(t, f)))
+    };
+    // In bands of their smallest id, as the check sorts them: all of a
+    // piece's at once were 5 MB of an MPI rank's peak (sphere_5e6 at 32
+    // parts, 4 ranks).
+    let shift = (32 - (pc.points.len() as u32).leading_zeros()).saturating_sub(12);
+    let mut hist = vec![0usize; (pc.points.len() >> shift) + 1];
+    faces().for_each(|v| hist[(v[0] >> shift) as usize] += 1);
+    let (ranges, _) = crate::check::bands(&hist, shift, band);
+    for (lo, hi) in ranges {
+        let band = faces().filter(|v| (lo..hi).contains(&u64::from(v[0])));
+        if pc.points.len() < 1 << 21 {
+            // Three 21-bit ids in a word: two thirds of the sort's memory.
+            let pack =
+                |v: [u32; 3]| u64::from(v[0]) | u64::from(v[1]) << 21 | u64::from(v[2]) << 42;
+            let unpack = |w: u64| [0, 21, 42].map(|s| ((w >> s) & 0x1f_ffff) as u32);
+            each_once(band.map(pack).collect(), |w| mark(unpack(w)));
+        } else {
+            each_once(band.collect(), &mut mark);
+        }
     }
     (0..pc.points.len() as u32)
         .filter(|&i| outer[i as usize])
         .collect()
 }
+
+/// Faces [`on_boundary`] sorts at once.
+const BOUNDARY_BAND: usize = 1 << 18;
 
 /// Calls `f` with each key that occurs only once in `keys`.
 fn each_once<K: Ord + Copy>(mut keys: Vec<K>, mut f: impl FnMut(K)) {
@@ -663,6 +760,140 @@ mod tests {
         pc.points.resize(n as usize, [0.0; 3]);
         let want: Vec<u32> = (1..7).map(|i| n - 7 + i).collect();
         assert_eq!(on_boundary(&pc), want);
+    }
+
+    /// A block of `n`^3 cubes of six tets each, in `np` slabs along x, one
+    /// piece a slab, its points numbered in the order its tets use them
+    /// (global ids: the block's).
+    fn slabs(n: usize, np: usize) -> Vec<Piece> {
+        let id = |x: usize, y: usize, z: usize| ((x * (n + 1) + y) * (n + 1) + z) as u32;
+        // Freudenthal's six tets of the unit cube, corners as bits xyz.
+        const KUHN: [[usize; 4]; 6] = [
+            [0, 1, 3, 7],
+            [0, 1, 5, 7],
+            [0, 2, 3, 7],
+            [0, 2, 6, 7],
+            [0, 4, 5, 7],
+            [0, 4, 6, 7],
+        ];
+        (0..np)
+            .map(|k| {
+                let mut pc = Piece::default();
+                let mut local: FxHashMap<u32, u32> = FxHashMap::default();
+                for x in k * n / np..(k + 1) * n / np {
+                    for y in 0..n {
+                        for z in 0..n {
+                            for t in KUHN {
+                                pc.tets.push(t.map(|c| {
+                                    let (a, b, d) = (x + (c >> 2), y + (c >> 1 & 1), z + (c & 1));
+                                    let g = id(a, b, d);
+                                    *local.entry(g).or_insert_with(|| {
+                                        pc.points.push([a as f64, b as f64, d as f64]);
+                                        pc.gid.push(g);
+                                        pc.points.len() as u32 - 1
+                                    })
+                                }));
+                                pc.tet_pass.push((x % 4 + 1) as u8);
+                            }
+                        }
+                    }
+                }
+                pc
+            })
+            .collect()
+    }
+
+    /// The boundary points found a band at a time are those found at once,
+    /// and those a count of every face finds.
+    #[test]
+    fn the_boundary_found_in_bands_is_the_boundary() {
+        let pc = &slabs(5, 2)[0];
+        let mut count: FxHashMap<[u32; 3], usize> = FxHashMap::default();
+        for t in &pc.tets {
+            for f in [[0, 1, 2], [0, 1, 3], [0, 2, 3], [1, 2, 3]] {
+                let mut v = f.map(|c| t[c]);
+                v.sort_unstable();
+                *count.entry(v).or_default() += 1;
+            }
+        }
+        let mut want: Vec<u32> = count
+            .iter()
+            .filter(|e| *e.1 == 1)
+            .flat_map(|e| *e.0)
+            .collect();
+        want.sort_unstable();
+        want.dedup();
+        assert!(!want.is_empty() && want.len() < pc.points.len());
+        for band in [1 << 20, 64, 7, 1] {
+            assert_eq!(on_boundary_in(pc, band), want, "band {band}");
+        }
+    }
+
+    /// Tets moved between pieces, those that stay kept in place, give the
+    /// pieces that sending every tet (its own piece's too) and building
+    /// the pieces from the batches gives: the same points, ids, tets,
+    /// passes and shared lists, for moves up, down and both.
+    #[test]
+    fn moving_only_the_leaving_tets_gives_the_rebuilt_pieces() {
+        let np = 4;
+        let comm = parafront_comm::Threads::new(np);
+        let pieces = slabs(6, np);
+        let mut x = 0x9e37_79b9_7f4a_7c15u64;
+        for way in 0..3 {
+            let dst: Vec<Vec<u32>> = pieces
+                .iter()
+                .enumerate()
+                .map(|(k, pc)| {
+                    (0..pc.tets.len())
+                        .map(|_| {
+                            x ^= x << 13;
+                            x ^= x >> 7;
+                            x ^= x << 17;
+                            let to = (x >> 8) as usize % np;
+                            let moves = x % 10 < 3
+                                && match way {
+                                    0 => to < k,
+                                    1 => to > k,
+                                    _ => true,
+                                };
+                            if moves {
+                                to as u32
+                            } else {
+                                k as u32
+                            }
+                        })
+                        .collect()
+                })
+                .collect();
+            let out = pieces
+                .iter()
+                .zip(&dst)
+                .map(|(pc, d)| batches(&pc.points, &pc.gid, &pc.tets, &pc.tet_pass, (d, None)))
+                .collect();
+            let mut want = receive_tets(comm.exchange(out)).unwrap();
+            number_tets(&comm, &mut want);
+            share_points(&comm, &mut want);
+            let got = move_pieces(&comm, pieces.clone(), |i, _| dst[i].clone()).unwrap();
+            let moved: usize = dst
+                .iter()
+                .enumerate()
+                .map(|(k, d)| d.iter().filter(|&&q| q as usize != k).count())
+                .sum();
+            assert!(moved > 0, "way {way}");
+            for (k, (a, (b, _))) in got.iter().zip(&want).enumerate() {
+                let at = format!("way {way}, piece {k}");
+                assert_eq!(a.points, b.points, "{at}");
+                assert_eq!(a.gid, b.gid, "{at}");
+                assert_eq!(a.tets, b.tets, "{at}");
+                assert_eq!(a.tet_pass, b.tet_pass, "{at}");
+                assert_eq!(a.tet_gid, b.tet_gid, "{at}");
+                assert_eq!(a.owner, b.owner, "{at}");
+                assert_eq!(a.neighbours, b.neighbours, "{at}");
+                assert_eq!(a.shared, b.shared, "{at}");
+            }
+            let total: usize = got.iter().map(|p| p.tets.len()).sum();
+            assert_eq!(total, 6 * 6 * 6 * 6);
+        }
     }
 
     /// The points in the order of their exact keys (-0.0 is 0.0), and two

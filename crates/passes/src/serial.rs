@@ -134,27 +134,29 @@ pub(super) fn remove_touching(
     // Faces of a positive tet, oriented into the tet (into the hole).
     const INWARD: [[usize; 3]; 4] = [[1, 3, 2], [0, 2, 3], [0, 3, 1], [0, 1, 2]];
     let mut out = Vec::new();
-    let mut kept = 0;
     let passes = std::mem::take(&mut part.tet_pass);
     let mut pass = passes.iter();
-    for t in 0..part.tets.len() {
-        let tv = part.tets[t];
-        let p = pass.next().expect("a pass for every tet");
-        let hits = tv
-            .iter()
-            .filter(|&&i| marked.contains(&part.gid[i as usize]))
-            .count();
-        if hits >= min_marked {
-            out.extend(INWARD.map(|f| f.map(|c| tv[c])));
-        } else {
-            part.tets[kept] = tv;
-            part.tet_pass.push_n(p, 1);
-            kept += 1;
-        }
-    }
-    let removed = part.tets.len() - kept;
-    part.tets.truncate(kept);
-    (removed, out)
+    let tets = std::mem::take(&mut part.tets);
+    let gid = &part.gid;
+    let tet_pass = &mut part.tet_pass;
+    part.tets = tets
+        .iter()
+        .filter(|tv| {
+            let p = pass.next().expect("a pass for every tet");
+            let hits = tv
+                .iter()
+                .filter(|&&i| marked.contains(&gid[i as usize]))
+                .count();
+            if hits >= min_marked {
+                out.extend(INWARD.map(|f| f.map(|c| tv[c])));
+                false
+            } else {
+                tet_pass.push_n(p, 1);
+                true
+            }
+        })
+        .collect();
+    (tets.len() - part.tets.len(), out)
 }
 
 /// A front over global points, numbered locally in the order the points
@@ -465,7 +467,7 @@ mod tests {
         let tets: Vec<[u32; 4]> = tets.iter().map(|t| t.map(&mut local)).collect();
         let front: Vec<[u32; 3]> = front.iter().map(|f| f.map(&mut local)).collect();
         p.tet_pass.push_n(1, tets.len());
-        (p.tets, p.front, p.stuck) = (tets, front, stuck.to_vec());
+        (p.tets, p.front, p.stuck) = (tets.into_iter().collect(), front, stuck.to_vec());
         p
     }
 
@@ -511,7 +513,7 @@ mod tests {
             let removed = peel_stuck(&mut parts, &Threads::new(np));
             // A had three stuck points, B two.
             assert_eq!(removed, 1, "{np} parts");
-            assert!(parts[0].tets.is_empty());
+            assert_eq!(parts[0].tets.len(), 0);
             assert_eq!(parts[1].tets.len(), 1);
             // A's faces into the hole: 0 1 2 stays (B is behind it); its
             // three others cancel the three faces out of A, one for one,

@@ -102,8 +102,10 @@ pub struct MeshOptions {
     /// more passes. See `parafront_improve::ImproveOptions`.
     #[serde(default = "default_optimize")]
     pub optimize: u8,
-    /// Parts improved in parallel (§9.5): 0 (default) one per 100k tets,
-    /// 1 serial. See `parafront_improve::ImproveOptions::parts`.
+    /// Parts improved in parallel (§9.5): 0 (default) one per 100k tets of
+    /// a merged mesh, and each piece of a partitioned one as one part (the
+    /// pieces are the parallel work already); 1 serial. See
+    /// `parafront_improve::ImproveOptions::parts`.
     #[serde(default)]
     pub optimize_parts: usize,
     /// Recovery rounds of a stalled front before the constrained fill

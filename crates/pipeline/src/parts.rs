@@ -218,11 +218,9 @@ fn serial_pieces<C: Comm>(
     }
     let n_points = comm.all_gather(said)[0];
     let mut pieces: Vec<Piece> = (0..held).map(|_| Piece::default()).collect();
-    let mut dst: Vec<Vec<u32>> = vec![Vec::new(); held];
     match made {
         Some(Err(e)) => return Err(e),
         Some(Ok(rm)) => {
-            dst[0] = crate::pieces::curve_parts(&rm.points, &rm.tets, comm.parts());
             let pc = &mut pieces[0];
             pc.gid = (0..rm.points.len() as u32).collect();
             pc.tet_pass = vec![4; rm.tets.len()];
@@ -237,6 +235,15 @@ fn serial_pieces<C: Comm>(
         }
         None => {}
     }
+    // Part 0's piece holds the whole mesh: its runs of the curve.
+    let np = comm.parts();
+    let dst = |i: usize, pc: &Piece| {
+        if comm.owned().start + i == 0 {
+            crate::pieces::curve_parts(&pc.points, &pc.tets, np)
+        } else {
+            Vec::new()
+        }
+    };
     let pieces = move_pieces(comm, pieces, dst).map_err(|source| MeshError::Parallel {
         region: rf.region_id as usize,
         source,
@@ -296,9 +303,17 @@ pub(crate) fn finish_pieces<C: Comm>(
         opts.note_phase(parafront_front::Phase::Improving);
         let t0 = Instant::now();
         let region: Vec<u32> = fronts.iter().map(|rf| rf.region_id).collect();
+        // A piece is one part unless asked: the pieces run in parallel
+        // already, and a piece's parts were each a copy of it beside it
+        // (sphere_5e6 at --parts 32: a second-round piece of 111k tets in
+        // two parts, 7 MB of an MPI rank's peak).
         let io = parafront_improve::ImproveOptions {
             level: opts.optimize,
-            parts: opts.optimize_parts,
+            parts: if opts.optimize_parts == 0 {
+                1
+            } else {
+                opts.optimize_parts
+            },
         };
         let mut inner = lattice_inner.to_vec();
         inner.sort_unstable();
@@ -308,6 +323,7 @@ pub(crate) fn finish_pieces<C: Comm>(
             &region,
             (s.points.len(), &inner),
             &io,
+            &|| opts.release(),
         )?;
         // The serial front's regions, shifted by the rounds' moves (on a
         // thin part, into one piece), get their runs of the curve again.

@@ -75,22 +75,17 @@ pub(super) fn move_clusters<C: Comm>(
             )
             .concat();
         let label = cluster_parts(&moved);
-        let dst: Vec<Vec<u32>> = chunk
-            .iter()
-            .enumerate()
-            .map(|(i, pc)| {
-                pc.tets
-                    .iter()
-                    .map(
-                        |t| match label.binary_search_by_key(&pc.gid[t[0] as usize], |x| x.0) {
-                            Ok(x) if touches(pc, t, &m) => label[x].1,
-                            _ => start + i as u32,
-                        },
-                    )
-                    .collect()
-            })
-            .collect();
-        parafront_passes::move_pieces(comm, chunk, dst)
+        parafront_passes::move_pieces(comm, chunk, |i, pc| {
+            pc.tets
+                .iter()
+                .map(
+                    |t| match label.binary_search_by_key(&pc.gid[t[0] as usize], |x| x.0) {
+                        Ok(x) if touches(pc, t, &m) => label[x].1,
+                        _ => start + i as u32,
+                    },
+                )
+                .collect()
+        })
     })
 }
 

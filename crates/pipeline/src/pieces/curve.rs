@@ -46,24 +46,23 @@ pub(crate) fn resplit<C: Comm>(comm: &C, pieces: Vec<Piece>) -> Result<Vec<Piece
     // pieces).
     let ext = [0, 1, 2].map(|k| (bb.max[k] - bb.min[k]).max(1e-300));
     let unit = |c: P3| [0, 1, 2].map(|k| (c[k] - bb.min[k]) / ext[k]);
-    let buckets: Vec<Vec<u32>> = pieces
-        .iter()
-        .map(|pc| {
-            pc.tets
-                .iter()
-                .map(|tv| {
-                    let c = unit(centroid(&pc.points, tv));
-                    (morton_key(c, [0.0; 3], 1.0) >> BUCKET_SHIFT) as u32
-                })
-                .collect()
-        })
-        .collect();
-    let counts = comm.all_reduce(
-        buckets
+    let buckets = |pc: &Piece| -> Vec<u32> {
+        pc.tets
             .iter()
-            .map(|b| {
+            .map(|tv| {
+                let c = unit(centroid(&pc.points, tv));
+                (morton_key(c, [0.0; 3], 1.0) >> BUCKET_SHIFT) as u32
+            })
+            .collect()
+    };
+    // The keys are made again as the tets are sent: held for every piece,
+    // they were a second copy of its tets' count.
+    let counts = comm.all_reduce(
+        pieces
+            .iter()
+            .map(|pc| {
                 let mut c = vec![0u32; BUCKETS];
-                for &k in b {
+                for k in buckets(pc) {
                     c[k as usize] += 1;
                 }
                 c
@@ -84,11 +83,9 @@ pub(crate) fn resplit<C: Comm>(comm: &C, pieces: Vec<Piece>) -> Result<Vec<Piece
             k
         })
         .collect();
-    let dst = buckets
-        .into_iter()
-        .map(|b| b.into_iter().map(|k| part[k as usize]).collect())
-        .collect();
-    move_pieces(comm, pieces, dst)
+    move_pieces(comm, pieces, |_, pc| {
+        buckets(pc).into_iter().map(|k| part[k as usize]).collect()
+    })
 }
 
 /// The corner and edge of the cube from `b`'s corner with its longest
