@@ -515,27 +515,73 @@ pub fn piece_boxes<'a, C: Comm>(comm: &C, pieces: impl Iterator<Item = &'a Piece
     .collect()
 }
 
+/// Cells per axis of a piece's [`Occupancy`].
+const CELLS: usize = 32;
+
+/// The cells of a piece's box (`CELLS` per axis) that hold a point of its
+/// boundary, a bit each: a point it shares with another piece is on both
+/// boundaries, so in a cell of both.
+type Occupancy = Vec<u64>;
+
+/// The cell of `b` (`CELLS` per axis) that holds `p`, a point of `b`:
+/// the same for the same coordinates on every process.
+fn cell(b: &Aabb, p: P3) -> usize {
+    let mut c = 0;
+    for k in 0..3 {
+        let e = b.max[k] - b.min[k];
+        let t = if e > 0.0 {
+            ((p[k] - b.min[k]) / e * CELLS as f64) as usize
+        } else {
+            0
+        };
+        c = c * CELLS + t.min(CELLS - 1);
+    }
+    c
+}
+
 /// Each piece's neighbours and shared points (the send/receive lists),
-/// and each point's owner: the lowest part that holds it.
+/// and each point's owner: the lowest part that holds it. A piece sends
+/// another the keys of its boundary points in a cell of the other's
+/// boundary (every point of its boundary in the other's box was 16 MB of
+/// an MPI rank's peak, sent and received, on sphere_5e6 at 32 parts).
 fn share_points<C: Comm>(comm: &C, pieces: &mut [Keyed]) {
     let boxes = piece_boxes(comm, pieces.iter().map(|p| &p.0));
     let start = comm.owned().start;
+    let outer: Vec<Vec<u32>> = pieces.par_iter().map(|(pc, _)| on_boundary(pc)).collect();
+    let occupied: Vec<Occupancy> = comm.all_gather(
+        pieces
+            .iter()
+            .zip(&outer)
+            .enumerate()
+            .map(|(i, ((pc, _), outer))| {
+                let mut bits = vec![0u64; (CELLS * CELLS * CELLS).div_ceil(64)];
+                for &j in outer {
+                    let c = cell(&boxes[start + i], pc.points[j as usize]);
+                    bits[c >> 6] |= 1 << (c & 63);
+                }
+                bits
+            })
+            .collect(),
+    );
     let out: Vec<Vec<(u32, Vec<Key>)>> = pieces
         .par_iter()
+        .zip(&outer)
         .enumerate()
-        .map(|(i, (pc, _))| {
+        .map(|(i, ((pc, _), outer))| {
             let k = start + i;
             let mut out = Vec::new();
-            let mut outer: Option<Vec<u32>> = None;
             for (q, b) in boxes.iter().enumerate() {
                 if q == k || b.is_empty() || !b.overlaps(&boxes[k]) {
                     continue;
                 }
-                let outer = outer.get_or_insert_with(|| on_boundary(pc));
+                let near = |p: P3| {
+                    let c = cell(b, p);
+                    occupied[q][c >> 6] >> (c & 63) & 1 == 1
+                };
                 let keys: Vec<Key> = outer
                     .iter()
                     .map(|&j| pc.points[j as usize])
-                    .filter(|&p| b.contains(p))
+                    .filter(|&p| b.contains(p) && near(p))
                     .map(key)
                     .collect();
                 if !keys.is_empty() {
@@ -633,26 +679,38 @@ fn each_once<K: Ord + Copy>(mut keys: Vec<K>, mut f: impl FnMut(K)) {
     }
 }
 
-/// Renumber the pieces' global point ids densely; the count.
+/// Renumber the pieces' global point ids densely (in their order, input
+/// points first); the count. The ids in use are a bit each, OR-ed over the
+/// processes: every piece's ids gathered on every process, and a new id
+/// for every old one, were 9 MB of each MPI rank's peak on sphere_5e6.
 fn number_points<C: Comm>(comm: &C, pieces: &mut [Piece], n_input: usize, n_gid: u32) -> u32 {
-    let mut used = vec![false; n_gid as usize];
-    used[..n_input].fill(true);
-    for ids in comm.all_gather(pieces.iter().map(|p| p.gid.clone()).collect()) {
-        for g in ids {
-            used[g as usize] = true;
-        }
+    let mut mine = vec![0u64; (n_gid as usize).div_ceil(64)];
+    let set = |w: &mut [u64], g: usize| w[g >> 6] |= 1 << (g & 63);
+    (0..n_input).for_each(|g| set(&mut mine, g));
+    for g in pieces.iter().flat_map(|pc| pc.gid.iter()) {
+        set(&mut mine, *g as usize);
     }
-    let mut renum = vec![u32::MAX; n_gid as usize];
+    // The process's bits in its first part's slot, none in the others.
+    let mut local = vec![Vec::new(); pieces.len()];
+    if let Some(first) = local.first_mut() {
+        *first = mine;
+    }
+    let used = comm.all_reduce(local, |a: Vec<u64>, b| {
+        let (mut long, short) = if a.len() >= b.len() { (a, b) } else { (b, a) };
+        long.iter_mut().zip(&short).for_each(|(x, y)| *x |= y);
+        long
+    });
+    // Ids in use before each word.
+    let mut before = Vec::with_capacity(used.len());
     let mut n = 0u32;
-    for (g, &u) in used.iter().enumerate() {
-        if u {
-            renum[g] = n;
-            n += 1;
-        }
+    for w in &used {
+        before.push(n);
+        n += w.count_ones();
     }
     for pc in pieces.iter_mut() {
         for g in &mut pc.gid {
-            *g = renum[*g as usize];
+            let (w, b) = (*g as usize >> 6, *g & 63);
+            *g = before[w] + (used[w] & ((1u64 << b) - 1)).count_ones();
         }
     }
     n
@@ -893,6 +951,139 @@ mod tests {
             }
             let total: usize = got.iter().map(|p| p.tets.len()).sum();
             assert_eq!(total, 6 * 6 * 6 * 6);
+        }
+    }
+
+    /// Each piece's neighbours and shared lists are the pieces and points
+    /// (ascending global id) it has in common with the others, its points'
+    /// owners the lowest pieces holding them: as a comparison of the ids
+    /// of every pair finds them, for slabs side by side and a block split
+    /// unevenly (boxes that overlap without a shared point).
+    #[test]
+    fn shared_points_are_those_two_pieces_hold() {
+        for (n, np) in [(6, 4), (7, 3), (5, 5)] {
+            let mut pieces: Vec<Keyed> = slabs(n, np)
+                .into_iter()
+                .map(|pc| {
+                    let k = by_key(&pc).unwrap();
+                    (pc, k)
+                })
+                .collect();
+            // Move a corner column of the last slab to the first piece:
+            // its box then spans the block.
+            if np > 2 {
+                let (a, b) = pieces.split_at_mut(np - 1);
+                let last = &mut b[0].0;
+                let first = &mut a[0].0;
+                let far = |t: &[u32; 4], pc: &Piece| {
+                    t.iter().all(|&j| {
+                        pc.points[j as usize][1] <= 1.0 && pc.points[j as usize][2] <= 1.0
+                    })
+                };
+                let mut moved = Vec::new();
+                let mut keep = Vec::new();
+                for (t, p) in last.tets.iter().zip(&last.tet_pass) {
+                    if far(t, last) {
+                        moved.push((
+                            t.map(|j| (last.gid[j as usize], last.points[j as usize])),
+                            *p,
+                        ));
+                    } else {
+                        keep.push((*t, *p));
+                    }
+                }
+                assert!(!moved.is_empty());
+                (last.tets, last.tet_pass) = keep.into_iter().unzip();
+                for (t, p) in moved {
+                    let v = t.map(|(g, x)| match first.gid.iter().position(|&h| h == g) {
+                        Some(j) => j as u32,
+                        None => {
+                            first.points.push(x);
+                            first.gid.push(g);
+                            first.points.len() as u32 - 1
+                        }
+                    });
+                    first.tets.push(v);
+                    first.tet_pass.push(p);
+                }
+                pieces[0].1 = by_key(&pieces[0].0).unwrap();
+            }
+            let comm = parafront_comm::Threads::new(np);
+            share_points(&comm, &mut pieces);
+            let used = |pc: &Piece| -> std::collections::BTreeSet<u32> {
+                pc.tets
+                    .iter()
+                    .flatten()
+                    .map(|&j| pc.gid[j as usize])
+                    .collect()
+            };
+            for (k, (pc, _)) in pieces.iter().enumerate() {
+                let mine = used(pc);
+                let mut want_n = Vec::new();
+                let mut want_s = Vec::new();
+                for (q, (other, _)) in pieces.iter().enumerate() {
+                    let both: Vec<u32> = used(other).intersection(&mine).copied().collect();
+                    if q == k || both.is_empty() {
+                        continue;
+                    }
+                    want_n.push(q as u32);
+                    want_s.push(both);
+                }
+                assert_eq!(pc.neighbours, want_n, "{n} {np}: piece {k}");
+                let got: Vec<Vec<u32>> = pc
+                    .shared
+                    .iter()
+                    .map(|l| l.iter().map(|&j| pc.gid[j as usize]).collect())
+                    .collect();
+                assert_eq!(got, want_s, "{n} {np}: piece {k}");
+                for (j, &g) in pc.gid.iter().enumerate() {
+                    let low = (0..np)
+                        .find(|&q| used(&pieces[q].0).contains(&g))
+                        .unwrap_or(k);
+                    if mine.contains(&g) {
+                        assert_eq!(pc.owner[j], low as u32, "{n} {np}: point {g}");
+                    }
+                }
+            }
+        }
+    }
+
+    /// The ids in use, input ids first, numbered densely in their order,
+    /// whichever piece uses them and across the words of the bitmap.
+    #[test]
+    fn point_ids_in_use_are_numbered_densely_in_order() {
+        let mut x = 0x2545_f491_4f6c_dd1du64;
+        for (n_gid, n_input) in [(1u32, 0usize), (64, 3), (1000, 130), (4097, 0)] {
+            let np = 3;
+            let pieces: Vec<Piece> = (0..np)
+                .map(|_| {
+                    let gid = (0..n_gid)
+                        .filter(|_| {
+                            x ^= x << 13;
+                            x ^= x >> 7;
+                            x ^= x << 17;
+                            x.is_multiple_of(7)
+                        })
+                        .collect();
+                    Piece {
+                        gid,
+                        ..Piece::default()
+                    }
+                })
+                .collect();
+            let mut used: Vec<u32> = (0..n_input as u32)
+                .chain(pieces.iter().flat_map(|p| p.gid.iter().copied()))
+                .collect();
+            used.sort_unstable();
+            used.dedup();
+            let mut got = pieces.clone();
+            let n = number_points(&parafront_comm::Threads::new(np), &mut got, n_input, n_gid);
+            assert_eq!(n as usize, used.len(), "{n_gid} ids");
+            for (a, b) in pieces.iter().zip(&got) {
+                for (g, h) in a.gid.iter().zip(&b.gid) {
+                    assert_eq!(used[*h as usize], *g);
+                }
+            }
         }
     }
 
