@@ -693,6 +693,17 @@ fn size_report_on_demand() {
     assert!(0.0 < min && min <= mean && mean <= max, "{line}");
     assert!(mean > 0.5 && mean < 2.0, "{line}");
     assert!(edges > tets_said(&text) as f64, "{line}");
+    // The same for a mesh kept in pieces (the field is kept for it only
+    // when asked).
+    let pieces = run(&["--parts", "4"], "sr2.pvtu");
+    assert!(pieces.contains("quality: min dihedral"), "{pieces}");
+    assert!(!pieces.contains("edge length / target size"), "{pieces}");
+    let pieces = run(&["--parts", "4", "--size-report"], "sr3.pvtu");
+    let line = pieces
+        .lines()
+        .find(|l| l.starts_with("edge length / target size:"))
+        .unwrap_or_else(|| panic!("no size report: {pieces}"));
+    assert!(line.contains(" mean "), "{line}");
 }
 
 /// `--parts auto`, the default: the summary says what it chose (the demo

@@ -289,16 +289,18 @@ type ParallelMesher<C> = fn(
 /// The end of a partitioned run (`gather` off): the pieces improved,
 /// checked and measured where they lie, the counts summed over the
 /// processes; the mesh is empty. `lattice_inner`: the global ids of the
-/// lattice's inner points, which improvement leaves alone.
+/// lattice's inner points, which improvement leaves alone. `sizing`: the
+/// field, where the quality report measures the sizes against it.
 pub(crate) fn finish_pieces<C: Comm>(
     s: &Surface,
     fronts: &[RegionFront],
-    sizing: &Sizing,
+    sizing: Option<Sizing>,
     opts: &MeshOptions,
     comm: &C,
     lattice_inner: &[u32],
     mut sum: Summary,
 ) -> Result<(TetMesh, Summary), MeshError> {
+    opts.release();
     if opts.optimize > 0 {
         opts.note_phase(parafront_front::Phase::Improving);
         let t0 = Instant::now();
@@ -376,8 +378,8 @@ pub(crate) fn finish_pieces<C: Comm>(
     sum.tets = tets;
     if !opts.no_quality {
         let t0 = Instant::now();
-        let size = |p| sizing.size(p);
-        let size: Option<&(dyn Fn(_) -> f64 + Sync)> = opts.size_report.then_some(&size);
+        let size = |p| sizing.as_ref().map_or(f64::NAN, |z| z.size(p));
+        let size: Option<&(dyn Fn(_) -> f64 + Sync)> = sizing.is_some().then_some(&size);
         sum.quality = crate::pieces::pieces_quality(comm, &sum.pieces, size);
         sum.push(Stage::Quality, t0.elapsed().as_secs_f64());
     }
