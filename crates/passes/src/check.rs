@@ -51,9 +51,15 @@ pub struct PieceCheckError {
 }
 
 /// Faces a part's check sorts at once (16 bytes each): more go in bands
-/// of their smallest global id. 2^20 were 11 MB of an MPI rank's peak
-/// (sphere_5e6 at 32 parts, 4 ranks: a piece has 680k faces).
-const BAND_FACES: usize = 1 << 18;
+/// of their smallest global id (2^20 were 11 MB of an MPI rank's peak on
+/// sphere_5e6 at 32 parts, 4 ranks, where a piece has 680k faces; 2^18, a
+/// third more time for the check).
+const BAND_FACES: usize = 1 << 19;
+
+/// The most bands a part's faces are sorted in: each band reads every tet
+/// again (ten bands of 2^18 faces were 2.5 s of sphere_5e6's run at
+/// `--parts 8`, in the check and the boundary points).
+pub(crate) const MAX_BANDS: usize = 4;
 
 /// Ranges `[lo, hi)` of smallest ids, bucket `b` of `hist` holding the
 /// faces whose smallest id is in `[b << shift, (b + 1) << shift)`, each
@@ -85,16 +91,18 @@ pub fn check_pieces<C: Comm>(
     tris: &[[u32; 3]],
     enclosed_vol6: f64,
 ) -> Result<PieceCheck, PieceCheckError> {
-    check_in_bands(comm, pieces, tris, enclosed_vol6, BAND_FACES)
+    let band = |faces: usize| BAND_FACES.max(faces.div_ceil(MAX_BANDS));
+    check_in_bands(comm, pieces, tris, enclosed_vol6, band)
 }
 
-/// [`check_pieces`] sorting at most `band` faces of a part at once.
+/// [`check_pieces`] sorting at most `band(faces)` faces of a part with
+/// `faces` faces at once.
 fn check_in_bands<C: Comm>(
     comm: &C,
     pieces: &[Vec<&Piece>],
     tris: &[[u32; 3]],
     enclosed_vol6: f64,
-    band: usize,
+    band: impl Fn(usize) -> usize + Sync,
 ) -> Result<PieceCheck, PieceCheckError> {
     let np = comm.parts() as u64;
     let input: FxHashSet<Key> = tris.iter().map(|&t| canon(t).0).collect();
@@ -153,6 +161,7 @@ fn check_in_bands<C: Comm>(
                 }
             };
             let n_faces = 4 * l.tets;
+            let band = band(n_faces);
             let (ranges, most) = if n_faces <= band {
                 (vec![(0, u64::MAX)], n_faces)
             } else {
@@ -344,7 +353,7 @@ mod tests {
         let all = check_pieces(&comm, &by_part, tris, vol6);
         // Sorted in bands of a few faces, the check says the same.
         for band in [1, 7, 40] {
-            assert_eq!(check_in_bands(&comm, &by_part, tris, vol6, band), all);
+            assert_eq!(check_in_bands(&comm, &by_part, tris, vol6, |_| band), all);
         }
         all
     }

@@ -624,41 +624,45 @@ fn share_points<C: Comm>(comm: &C, pieces: &mut [Keyed]) {
 /// all its tets there. Sending every point in a neighbour's box instead
 /// was 30 MB of each MPI rank's peak (sphere_5e6, 4 ranks, 32 parts).
 fn on_boundary(pc: &Piece) -> Vec<u32> {
-    on_boundary_in(pc, BOUNDARY_BAND)
+    let faces = 4 * pc.tets.len();
+    on_boundary_in(
+        pc,
+        BOUNDARY_BAND.max(faces.div_ceil(crate::check::MAX_BANDS)),
+    )
 }
 
 /// [`on_boundary`] sorting about `band` faces at once.
 fn on_boundary_in(pc: &Piece, band: usize) -> Vec<u32> {
-    const FACES: [[usize; 3]; 4] = [[0, 1, 2], [0, 1, 3], [0, 2, 3], [1, 2, 3]];
     let mut outer = vec![false; pc.points.len()];
     let mut mark = |f: [u32; 3]| f.iter().for_each(|&i| outer[i as usize] = true);
-    let sorted = |t: &[u32; 4], f: [usize; 3]| {
-        let mut v = f.map(|k| t[k]);
-        v.sort_unstable();
-        v
-    };
-    let faces = || {
-        pc.tets
-            .iter()
-            .flat_map(move |t| FACES.map(|f| sorted(t, f)))
-    };
     // In bands of their smallest id, as the check sorts them: all of a
     // piece's at once were 5 MB of an MPI rank's peak (sphere_5e6 at 32
-    // parts, 4 ranks).
+    // parts, 4 ranks). A face's smallest id is two compares; only the
+    // faces of the band are sorted and kept.
     let shift = (32 - (pc.points.len() as u32).leading_zeros()).saturating_sub(12);
     let mut hist = vec![0usize; (pc.points.len() >> shift) + 1];
-    faces().for_each(|v| hist[(v[0] >> shift) as usize] += 1);
-    let (ranges, _) = crate::check::bands(&hist, shift, band);
-    for (lo, hi) in ranges {
-        let band = faces().filter(|v| (lo..hi).contains(&u64::from(v[0])));
-        if pc.points.len() < 1 << 21 {
-            // Three 21-bit ids in a word: two thirds of the sort's memory.
-            let pack =
-                |v: [u32; 3]| u64::from(v[0]) | u64::from(v[1]) << 21 | u64::from(v[2]) << 42;
-            let unpack = |w: u64| [0, 21, 42].map(|s| ((w >> s) & 0x1f_ffff) as u32);
-            each_once(band.map(pack).collect(), |w| mark(unpack(w)));
-        } else {
-            each_once(band.collect(), &mut mark);
+    for t in &pc.tets {
+        for f in TET_FACES {
+            hist[(t[f[0]].min(t[f[1]]).min(t[f[2]]) >> shift) as usize] += 1;
+        }
+    }
+    let (ranges, most) = crate::check::bands(&hist, shift, band);
+    if pc.points.len() < 1 << 21 {
+        // Three 21-bit ids in a word: two thirds of the sort's memory.
+        let pack = |v: [u32; 3]| u64::from(v[0]) | u64::from(v[1]) << 21 | u64::from(v[2]) << 42;
+        let unpack = |w: u64| [0, 21, 42].map(|s| ((w >> s) & 0x1f_ffff) as u32);
+        let mut keys = Vec::with_capacity(most);
+        for (lo, hi) in ranges {
+            keys.clear();
+            band_faces(pc, (lo, hi), |v| keys.push(pack(v)));
+            each_once(&mut keys, |w| mark(unpack(w)));
+        }
+    } else {
+        let mut keys = Vec::with_capacity(most);
+        for (lo, hi) in ranges {
+            keys.clear();
+            band_faces(pc, (lo, hi), |v| keys.push(v));
+            each_once(&mut keys, &mut mark);
         }
     }
     (0..pc.points.len() as u32)
@@ -666,11 +670,33 @@ fn on_boundary_in(pc: &Piece, band: usize) -> Vec<u32> {
         .collect()
 }
 
+/// A tet's faces, by corner.
+const TET_FACES: [[usize; 3]; 4] = [[0, 1, 2], [0, 1, 3], [0, 2, 3], [1, 2, 3]];
+
+/// Each face of `pc`'s tets whose smallest id is in `[lo, hi)`, its ids
+/// ascending.
+fn band_faces(pc: &Piece, (lo, hi): (u64, u64), mut f: impl FnMut([u32; 3])) {
+    for t in &pc.tets {
+        for c in TET_FACES {
+            let [a, b, d] = c.map(|k| t[k]);
+            let m = a.min(b).min(d);
+            if (lo..hi).contains(&u64::from(m)) {
+                let top = a.max(b).max(d);
+                // The middle one: the sum less the ends (no overflow in u64).
+                let mid = (u64::from(a) + u64::from(b) + u64::from(d)
+                    - u64::from(m)
+                    - u64::from(top)) as u32;
+                f([m, mid, top]);
+            }
+        }
+    }
+}
+
 /// Faces [`on_boundary`] sorts at once.
 const BOUNDARY_BAND: usize = 1 << 18;
 
-/// Calls `f` with each key that occurs only once in `keys`.
-fn each_once<K: Ord + Copy>(mut keys: Vec<K>, mut f: impl FnMut(K)) {
+/// Calls `f` with each key that occurs only once in `keys` (sorted here).
+fn each_once<K: Ord + Copy>(keys: &mut [K], mut f: impl FnMut(K)) {
     keys.sort_unstable();
     for run in keys.chunk_by(|a, b| a == b) {
         if let [k] = run {
