@@ -15,8 +15,8 @@ use rustc_hash::FxHashSet;
 /// the next two ascending, with whether that kept the orientation.
 type Key = [u32; 3];
 
-/// Faces of a positive tet, outward.
-const OUTWARD: [[usize; 3]; 4] = [[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]];
+// Faces of a positive tet, outward.
+use parafront_mesh::TET_FACES as OUTWARD;
 
 fn canon(w: [u32; 3]) -> (Key, bool) {
     let r = (0..3).min_by_key(|&k| w[k]).unwrap_or(0);
@@ -65,7 +65,7 @@ pub(crate) const MAX_BANDS: usize = 4;
 /// faces whose smallest id is in `[b << shift, (b + 1) << shift)`, each
 /// range with at most `band` faces unless one bucket has more; and the most
 /// faces in one range.
-pub(crate) fn bands(hist: &[usize], shift: u32, band: usize) -> (Vec<(u64, u64)>, usize) {
+fn bands(hist: &[usize], shift: u32, band: usize) -> (Vec<(u64, u64)>, usize) {
     let (mut ranges, mut most) = (Vec::new(), 0);
     let (mut lo, mut n) = (0u64, 0usize);
     for (b, &c) in hist.iter().enumerate() {
@@ -79,6 +79,25 @@ pub(crate) fn bands(hist: &[usize], shift: u32, band: usize) -> (Vec<(u64, u64)>
     }
     ranges.push((lo, u64::MAX));
     (ranges, most.max(n))
+}
+
+/// The bands of smallest ids of `n_faces` faces whose ids are at most
+/// `max_id`, as [`bands`] makes them, and the most faces in one; one band
+/// of all when they fit in `band`, else `mins` gives each face's smallest
+/// id (to count them by bucket).
+pub(crate) fn face_bands(
+    n_faces: usize,
+    max_id: u32,
+    band: usize,
+    mins: impl FnOnce(&mut dyn FnMut(u32)),
+) -> (Vec<(u64, u64)>, usize) {
+    if n_faces <= band {
+        return (vec![(0, u64::MAX)], n_faces);
+    }
+    let shift = (32 - max_id.leading_zeros()).saturating_sub(12);
+    let mut hist = vec![0usize; (max_id >> shift) as usize + 1];
+    mins(&mut |m| hist[(m >> shift) as usize] += 1);
+    bands(&hist, shift, band)
 }
 
 /// Checks the pieces this process holds, `pieces[i]` those of part
@@ -161,16 +180,11 @@ fn check_in_bands<C: Comm>(
                 }
             };
             let n_faces = 4 * l.tets;
-            let band = band(n_faces);
-            let (ranges, most) = if n_faces <= band {
-                (vec![(0, u64::MAX)], n_faces)
-            } else {
-                let max_id = list.iter().flat_map(|pc| pc.gid.iter()).copied().max();
-                let shift = (32 - max_id.unwrap_or(0).leading_zeros()).saturating_sub(12);
-                let mut hist = vec![0usize; 1 << 12];
-                faces_of(&mut |(k, _)| hist[(k[0] >> shift) as usize] += 1);
-                bands(&hist, shift, band)
-            };
+            let max_id = list.iter().flat_map(|pc| pc.gid.iter()).copied().max();
+            let (ranges, most) =
+                face_bands(n_faces, max_id.unwrap_or(0), band(n_faces), |f| {
+                    faces_of(&mut |(k, _)| f(k[0]))
+                });
             let mut faces: Vec<(Key, bool)> = Vec::with_capacity(most);
             for &(lo, hi) in &ranges {
                 faces.clear();

@@ -7,6 +7,7 @@ use crate::{PackedTets, ParOutput, Part, PassError};
 use parafront_comm::{Comm, Wire, WireError};
 use parafront_ddg::Locator;
 use parafront_geom::{Aabb, P3};
+use parafront_mesh::TET_FACES;
 use rayon::prelude::*;
 use rustc_hash::FxHashMap;
 
@@ -205,10 +206,17 @@ pub fn move_pieces<C: Comm>(
             let dst = dst(i, &pc);
             debug_assert!(dst.len() == pc.tets.len() || pc.tets.is_empty());
             let out = batches(&pc.points, &pc.gid, &pc.tets, &pc.tet_pass, (&dst, Some(k)));
-            let mut stay = dst.iter().map(|&d| d == k);
-            pc.tets.retain(|_| stay.next().unwrap_or(true));
-            let mut stay = dst.iter().map(|&d| d == k);
-            pc.tet_pass.retain(|_| stay.next().unwrap_or(true));
+            // The tets that stay, in order, with their passes.
+            let mut kept = 0;
+            for (t, &d) in dst.iter().enumerate() {
+                if d == k {
+                    pc.tets[kept] = pc.tets[t];
+                    pc.tet_pass[kept] = pc.tet_pass[t];
+                    kept += 1;
+                }
+            }
+            pc.tets.truncate(kept);
+            pc.tet_pass.truncate(kept);
             (out, pc)
         })
         .unzip();
@@ -639,14 +647,14 @@ fn on_boundary_in(pc: &Piece, band: usize) -> Vec<u32> {
     // piece's at once were 5 MB of an MPI rank's peak (sphere_5e6 at 32
     // parts, 4 ranks). A face's smallest id is two compares; only the
     // faces of the band are sorted and kept.
-    let shift = (32 - (pc.points.len() as u32).leading_zeros()).saturating_sub(12);
-    let mut hist = vec![0usize; (pc.points.len() >> shift) + 1];
-    for t in &pc.tets {
-        for f in TET_FACES {
-            hist[(t[f[0]].min(t[f[1]]).min(t[f[2]]) >> shift) as usize] += 1;
+    let max_id = (pc.points.len() as u32).saturating_sub(1);
+    let (ranges, most) = crate::check::face_bands(4 * pc.tets.len(), max_id, band, |f| {
+        for t in &pc.tets {
+            for c in TET_FACES {
+                f(t[c[0]].min(t[c[1]]).min(t[c[2]]));
+            }
         }
-    }
-    let (ranges, most) = crate::check::bands(&hist, shift, band);
+    });
     if pc.points.len() < 1 << 21 {
         // Three 21-bit ids in a word: two thirds of the sort's memory.
         let pack = |v: [u32; 3]| u64::from(v[0]) | u64::from(v[1]) << 21 | u64::from(v[2]) << 42;
@@ -669,9 +677,6 @@ fn on_boundary_in(pc: &Piece, band: usize) -> Vec<u32> {
         .filter(|&i| outer[i as usize])
         .collect()
 }
-
-/// A tet's faces, by corner.
-const TET_FACES: [[usize; 3]; 4] = [[0, 1, 2], [0, 1, 3], [0, 2, 3], [1, 2, 3]];
 
 /// Each face of `pc`'s tets whose smallest id is in `[lo, hi)`, its ids
 /// ascending.

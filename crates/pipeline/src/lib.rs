@@ -487,13 +487,13 @@ fn mesh_sized<C: Comm>(
             comm,
             mesh_parallel_around,
         )?;
-        opts.release();
         if !opts.gather {
             // The field is done with unless the report measures against it
             // (sphere_5e6: 8 MB of every process, through the improvement).
             let sizing = opts.size_report.then_some(sizing);
             return finish_pieces(s, &fronts, sizing, opts, comm, &inner, sum).map(Some);
         }
+        opts.release();
         if !comm.holds(0) {
             return Ok(None);
         }

@@ -300,6 +300,8 @@ pub(crate) fn finish_pieces<C: Comm>(
     lattice_inner: &[u32],
     mut sum: Summary,
 ) -> Result<(TetMesh, Summary), MeshError> {
+    // What the passes freed, and the field where it was dropped, go back
+    // before the improvement builds its meshes.
     opts.release();
     if opts.optimize > 0 {
         opts.note_phase(parafront_front::Phase::Improving);
