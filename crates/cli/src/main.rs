@@ -382,7 +382,7 @@ pub(crate) fn run_mesh_on<C: Comm>(
     parallel::print_parallel(&sum);
     println!("wrote {}", out.display());
     if let Some(p) = &a.pvtu {
-        let written = parallel::write_partitioned(p, &sum, &wopts)?;
+        let written = parallel::write_partitioned(p, &mut sum, &wopts)?;
         println!("wrote {} ({written} pieces)", p.display());
     }
     if let (Some(p), Some(q)) = (&a.plot, &sum.quality) {

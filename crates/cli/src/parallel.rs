@@ -83,7 +83,7 @@ pub fn print_parallel(sum: &Summary) {
 /// point and cell ids, the owning part of each point, a ghost flag on the
 /// points another part owns, and the number of parts sharing each point.
 /// Returns the number of pieces written (empty ones are left out).
-pub fn write_partitioned(path: &Path, sum: &Summary, w: &WriteOptions) -> Result<usize, Fail> {
+pub fn write_partitioned(path: &Path, sum: &mut Summary, w: &WriteOptions) -> Result<usize, Fail> {
     // A merged run keeps no pieces of a region the serial front meshed.
     if let Some(&(r, _)) = sum.serial_fallback.first() {
         return Err(Fail(
@@ -92,7 +92,8 @@ pub fn write_partitioned(path: &Path, sum: &Summary, w: &WriteOptions) -> Result
         ));
     }
     let tets: Vec<usize> = sum.pieces.iter().map(|pc| pc.tets.len()).collect();
-    write_partitioned_share(path, sum, w, 0..sum.piece_parts, &tets)?;
+    let parts = 0..sum.piece_parts;
+    write_partitioned_share(path, sum, w, parts, &tets)?;
     Ok(tets.iter().filter(|&&n| n > 0).count())
 }
 
@@ -100,10 +101,13 @@ pub fn write_partitioned(path: &Path, sum: &Summary, w: &WriteOptions) -> Result
 /// pieces, and the index where part 0 is held. `tets[r * parts + k]`:
 /// the tets of region r's piece of part k, over all processes; an empty
 /// piece is neither written nor named (meshio cannot read a piece
-/// without cells). Returns the files written.
+/// without cells). The pieces leave `sum` as they are written: each one's
+/// points and tets go into its file's mesh, and its memory is returned
+/// before the next (copies of them set each MPI rank's peak on sphere_5e6).
+/// Returns the files written.
 pub(crate) fn write_partitioned_share(
     path: &Path,
-    sum: &Summary,
+    sum: &mut Summary,
     w: &WriteOptions,
     held: std::ops::Range<usize>,
     tets: &[usize],
@@ -135,6 +139,10 @@ pub(crate) fn write_partitioned_share(
         .filter(|&i| !sum.pieces[i].tets.is_empty())
         .map(|i| (i, i / n_held))
         .collect();
+    let mut pieces: Vec<Option<_>> = std::mem::take(&mut sum.pieces)
+        .into_iter()
+        .map(Some)
+        .collect();
     let ids: Vec<usize> = shown
         .iter()
         .map(|&(i, r)| r * parts + held.start + i % n_held)
@@ -143,7 +151,10 @@ pub(crate) fn write_partitioned_share(
     // process held a second copy of all its pieces here (its peak on
     // sphere_5e6 at 4 ranks).
     let arrays = shown.iter().map(|&(i, r)| {
-        let (pc, k) = (&sum.pieces[i], held.start + i % n_held);
+        let (pc, k) = (
+            pieces[i].take().expect("each piece is written once"),
+            held.start + i % n_held,
+        );
         let cell_base = region_base[r];
         let mut sharers = vec![0i32; pc.points.len()];
         for list in &pc.shared {
@@ -151,12 +162,17 @@ pub(crate) fn write_partitioned_share(
                 sharers[p as usize] += 1;
             }
         }
-        let region = r as u32 + 1;
+        let region = vec![r as u32 + 1; pc.tets.len()];
         Arrays {
             mesh: TetMesh {
-                points: pc.points.clone(),
-                tets: pc.tets.iter().map(|t| t.map(PointId::from_raw)).collect(),
-                region: vec![region; pc.tets.len()],
+                // In place: `PointId` is a transparent `u32`.
+                tets: pc
+                    .tets
+                    .into_iter()
+                    .map(|t| t.map(PointId::from_raw))
+                    .collect(),
+                points: pc.points,
+                region,
                 ..Default::default()
             },
             gid: pc.gid.iter().map(|&g| g as i64).collect(),

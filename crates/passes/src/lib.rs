@@ -446,11 +446,42 @@ pub fn mesh_parallel_around<C: Comm>(
     points: &[P3],
     point_size: &[f64],
     faces: &[[u32; 3]],
-    (core, core_tets): (&[[u32; 3]], &[Vec<[u32; 4]>]),
+    core: (&[[u32; 3]], &[Vec<[u32; 4]>]),
     size: &(dyn Fn(P3) -> f64 + Sync),
     opts: &ParOptions,
     comm: &C,
 ) -> Result<ParOutput, PassError> {
+    passes_around(points, point_size, faces, core, size, opts, comm)?
+        .redistribute(points, opts, comm)
+}
+
+/// The tets of the passes, each with the part it goes to, before §8's
+/// redistribution: [`mesh_parallel_around`] in two steps, so that a
+/// caller can free what only the passes needed (the size field: 7 MB of
+/// each MPI rank's peak on sphere_5e6, which redistribution set) before
+/// the tets move. The size field is not used after [`passes_around`].
+pub struct Passed {
+    parts: Vec<part::Part>,
+    dst: Vec<redistribute::Dests>,
+    next_gid: u32,
+    rec: Recorder,
+    t0: Instant,
+}
+
+/// [`mesh_parallel_around`] up to redistribution: the DDG, its
+/// partition, and passes 1 to 4. The errors that send a region to the
+/// serial front ([`PassError::Pass`], [`PassError::Unsuited`],
+/// [`PassError::Thin`], a failed DDG, a remote pass failure) all come
+/// from here; [`Passed::redistribute`] fails only as a run stopper.
+pub fn passes_around<C: Comm>(
+    points: &[P3],
+    point_size: &[f64],
+    faces: &[[u32; 3]],
+    (core, core_tets): (&[[u32; 3]], &[Vec<[u32; 4]>]),
+    size: &(dyn Fn(P3) -> f64 + Sync),
+    opts: &ParOptions,
+    comm: &C,
+) -> Result<Passed, PassError> {
     let np = comm.parts();
     let depth = ddg_build::depth(points, faces);
     if depth < opts.thin_depth {
@@ -545,26 +576,55 @@ pub fn mesh_parallel_around<C: Comm>(
     drop((on, loc));
     drop(d);
     release(opts.release);
-    let sent = redistribute::send(parts, dst, comm);
-    let out = redistribute::finish(sent, comm, points, next_gid, opts)?;
-    let held = comm.all_gather(out.pieces.iter().map(|p| p.tets.len()).collect());
-    let pass_tets = comm.all_reduce(
-        out.pieces
-            .iter()
-            .map(|pc| {
-                let mut n = [0usize; 4];
-                // The core's tets (pass 0) are no pass's.
-                for &p in &pc.tet_pass {
-                    if let Some(x) = (p as usize).checked_sub(1).and_then(|i| n.get_mut(i)) {
-                        *x += 1;
+    Ok(Passed {
+        parts,
+        dst,
+        next_gid,
+        rec,
+        t0,
+    })
+}
+
+impl Passed {
+    /// §8: the tets to their parts, the points numbered and shared. The
+    /// output holds every point of `points` (the ones the passes were
+    /// given) in order.
+    pub fn redistribute<C: Comm>(
+        self,
+        points: &[P3],
+        opts: &ParOptions,
+        comm: &C,
+    ) -> Result<ParOutput, PassError> {
+        let Passed {
+            parts,
+            dst,
+            next_gid,
+            rec,
+            t0,
+        } = self;
+        // What the caller freed since is returned before the tets move.
+        release(opts.release);
+        let sent = redistribute::send(parts, dst, comm);
+        let out = redistribute::finish(sent, comm, points, next_gid, opts)?;
+        let held = comm.all_gather(out.pieces.iter().map(|p| p.tets.len()).collect());
+        let pass_tets = comm.all_reduce(
+            out.pieces
+                .iter()
+                .map(|pc| {
+                    let mut n = [0usize; 4];
+                    // The core's tets (pass 0) are no pass's.
+                    for &p in &pc.tet_pass {
+                        if let Some(x) = (p as usize).checked_sub(1).and_then(|i| n.get_mut(i)) {
+                            *x += 1;
+                        }
                     }
-                }
-                n
-            })
-            .collect(),
-        |a, b| [0, 1, 2, 3].map(|i| a[i] + b[i]),
-    );
-    Ok(rec.finish(out, held, pass_tets, t0.elapsed().as_secs_f64()))
+                    n
+                })
+                .collect(),
+            |a, b| [0, 1, 2, 3].map(|i| a[i] + b[i]),
+        );
+        Ok(rec.finish(out, held, pass_tets, t0.elapsed().as_secs_f64()))
+    }
 }
 
 /// The DDG of the front: by `opts.ddg_passes` parallel passes, or by the

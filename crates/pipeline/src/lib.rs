@@ -30,7 +30,7 @@ use parafront_comm::Comm;
 use parafront_ddg::DdgError;
 use parafront_front::{advance, FrontError, FrontInput, FrontOptions, SizeMode};
 use parafront_mesh::{CheckError, PointId, QualityReport, TetMesh, TopoError};
-use parafront_passes::{mesh_parallel_around, ParOptions, ParOutput, PassError};
+use parafront_passes::{passes_around, ParOptions, PassError, Passed};
 pub use parafront_passes::{process_cpu_seconds, DDG_CAP, SERIAL_FROM, THIN_DEPTH};
 use parafront_size::{SizeError, SizeField, SizeOptions, Sizing};
 use parafront_surface::validate::{shells, validate, Report, Shell, ShellKind};
@@ -476,34 +476,35 @@ fn mesh_sized<C: Comm>(
     } else {
         TetMesh::default()
     };
-    let lattice_inner = if opts.parts > 1 {
-        let inner = mesh_parts(
+    let (lattice_inner, sizing) = if opts.parts > 1 {
+        // Without a merged mesh, the field is kept only for the report
+        // (sphere_5e6: 8 MB of every process, through the improvement).
+        let (inner, sizing) = mesh_parts(
             s,
             &fronts,
-            &sizing,
+            Some(sizing),
             opts,
             &mut mesh,
             &mut sum,
             comm,
-            mesh_parallel_around,
+            passes_around,
         )?;
         if !opts.gather {
-            // The field is done with unless the report measures against it
-            // (sphere_5e6: 8 MB of every process, through the improvement).
-            let sizing = opts.size_report.then_some(sizing);
+            // Kept by regions that all went to the serial front.
+            let sizing = sizing.filter(|_| opts.size_report);
             return finish_pieces(s, &fronts, sizing, opts, comm, &inner, sum).map(Some);
         }
         opts.release();
         if !comm.holds(0) {
             return Ok(None);
         }
-        inner
+        (inner, sizing)
     } else {
         let lat0 = sum.seconds(Stage::Lattice);
         let inner = mesh_serial(s, &fronts, &sizing, opts, &mut mesh, &mut sum)?;
         let lat = sum.seconds(Stage::Lattice) - lat0;
         sum.push(Stage::Front, t0.elapsed().as_secs_f64() - lat);
-        inner
+        (inner, Some(sizing))
     };
     opts.release();
 
@@ -559,12 +560,11 @@ fn mesh_sized<C: Comm>(
         // With the run's size field: building it again for the report took
         // as long as the size field stage.
         let t0 = Instant::now();
-        sum.quality = Some(if opts.size_report {
-            QualityReport::with_size(&mesh, |p| sizing.size(p))
-        } else if let Some(aside) = &aside {
-            lattice::report_after(&mesh, aside)
-        } else {
-            QualityReport::new(&mesh)
+        // A merged mesh keeps its field (`mesh_parts`).
+        sum.quality = Some(match (&sizing, &aside) {
+            (Some(f), _) if opts.size_report => QualityReport::with_size(&mesh, |p| f.size(p)),
+            (_, Some(aside)) => lattice::report_after(&mesh, aside),
+            _ => QualityReport::new(&mesh),
         });
         sum.push(Stage::Quality, t0.elapsed().as_secs_f64());
     }

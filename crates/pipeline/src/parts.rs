@@ -13,19 +13,22 @@ use parafront_passes::{move_pieces, Piece};
 pub(crate) fn mesh_parts<C: Comm>(
     s: &Surface,
     fronts: &[RegionFront],
-    sizing: &Sizing,
+    mut held: Option<Sizing>,
     opts: &MeshOptions,
     mesh: &mut TetMesh,
     sum: &mut Summary,
     comm: &C,
     parallel: ParallelMesher<C>,
-) -> Result<Vec<u32>, MeshError> {
+) -> Result<(Vec<u32>, Option<Sizing>), MeshError> {
+    // Pieces need the field no more once the last region's passes are
+    // done, unless the report measures against it: it goes before the
+    // tets move (§8), which set each MPI rank's peak.
+    let free_field = !opts.gather && !opts.size_report;
     let holds = comm.holds(0);
     // Without the merged mesh, where each region's new points start.
     let mut next_base = s.points.len() as u32;
     // The lattice's inner points, for improvement to leave alone.
     let mut lattice_inner = Vec::new();
-    let field = |p| sizing.size(p);
     let popts = ParOptions {
         parts: opts.parts,
         growth: if opts.ddg_growth > 0.0 {
@@ -48,7 +51,10 @@ pub(crate) fn mesh_parts<C: Comm>(
     };
     // Seconds of each of `Stage::PARALLEL`, summed over the regions.
     let mut stage = [0.0f64; Stage::PARALLEL.len()];
-    for rf in fronts {
+    for (ri, rf) in fronts.iter().enumerate() {
+        // Freed only after the last region's passes.
+        let Some(sizing) = held.as_ref() else { break };
+        let field = |p| sizing.size(p);
         let (mut pts, mut hs) = region_points(s, sizing, rf);
         // The lattice fills the core; the passes mesh the layer between it
         // and the surface.
@@ -71,7 +77,17 @@ pub(crate) fn mesh_parts<C: Comm>(
         };
         let t_par = Instant::now();
         let around = (&core[..], &core_tets[..]);
-        let out = match parallel(&pts, &hs, &rf.faces, around, &field, &popts, comm) {
+        let passed = parallel(&pts, &hs, &rf.faces, around, &field, &popts, comm);
+        drop(hs);
+        let last = ri + 1 == fronts.len();
+        let passed = match passed {
+            Ok(p) if free_field && last => {
+                held = None;
+                Ok(p)
+            }
+            r => r,
+        };
+        let out = match passed.and_then(|p| p.redistribute(&pts, &popts, comm)) {
             Ok(out) => out,
             // A valid surface must not fail (AF5, step 4): a front the
             // passes leave unclosable (CAD needles next to a part wall) gets
@@ -86,6 +102,14 @@ pub(crate) fn mesh_parts<C: Comm>(
                 | PassError::Thin { .. }
                 | PassError::Ddg(DdgError::Front(_))),
             ) => {
+                // Redistribution's errors stop the run: the field freed
+                // before it is never wanted here.
+                let Some(sizing) = held.as_ref() else {
+                    return Err(MeshError::Parallel {
+                        region: rf.region_id as usize,
+                        source: e,
+                    });
+                };
                 tracing::warn!(
                     region = rf.region_id,
                     "parallel passes given up ({e}); meshing serially"
@@ -167,12 +191,12 @@ pub(crate) fn mesh_parts<C: Comm>(
         sum.parallel.push(out.stats);
     }
     if sum.parallel.is_empty() {
-        return Ok(lattice_inner); // every region went to the serial front
+        return Ok((lattice_inner, held)); // every region went to the serial front
     }
     for (name, x) in Stage::PARALLEL.into_iter().zip(stage) {
         sum.push(name, x);
     }
-    Ok(lattice_inner)
+    Ok((lattice_inner, held))
 }
 
 /// Region `rf`'s pieces (of `parts` parts) into the summary, their points'
@@ -284,7 +308,7 @@ type ParallelMesher<C> = fn(
     &(dyn Fn(parafront_geom::P3) -> f64 + Sync),
     &ParOptions,
     &C,
-) -> Result<ParOutput, PassError>;
+) -> Result<Passed, PassError>;
 
 /// The end of a partitioned run (`gather` off): the pieces improved,
 /// checked and measured where they lie, the counts summed over the
@@ -406,7 +430,7 @@ mod tests {
             _: &(dyn Fn(parafront_geom::P3) -> f64 + Sync),
             _: &ParOptions,
             _: &parafront_comm::Threads,
-        ) -> Result<ParOutput, PassError> {
+        ) -> Result<Passed, PassError> {
             Err(PassError::Pass {
                 pass: 4,
                 part: 0,
@@ -432,10 +456,19 @@ mod tests {
         let mut mesh = surface_mesh(&s);
         let mut sum = Summary::default();
         let comm = parafront_comm::Threads::new(opts.parts);
-        mesh_parts(
-            &s, &fronts, &sizing, &opts, &mut mesh, &mut sum, &comm, stuck,
+        let (_, held) = mesh_parts(
+            &s,
+            &fronts,
+            Some(sizing),
+            &opts,
+            &mut mesh,
+            &mut sum,
+            &comm,
+            stuck,
         )
         .unwrap();
+        // A merged run keeps its field for what follows the passes.
+        assert!(held.is_some());
         assert_eq!(sum.serial_fallback.len(), 1);
         assert_eq!(sum.serial_fallback[0].0, 1);
         assert!(sum.serial_fallback[0].1.contains("pass 4"));
@@ -444,5 +477,48 @@ mod tests {
         mesh.check_against_surface(&s.tris).unwrap();
         let v = mesh.volume();
         assert!((v - s.signed_volume()).abs() < 1e-9 * v, "{v}");
+    }
+
+    #[test]
+    fn pieces_free_the_field_before_redistribution_unless_the_report_wants_it() {
+        let s = generate::torus([0.0; 3], 2.0, 0.7, 48, 24);
+        let report = validate(&s);
+        let fronts = material_regions(&s, &report.shells);
+        for size_report in [false, true] {
+            let opts = MeshOptions {
+                parts: 4,
+                gather: false,
+                size_report,
+                ..MeshOptions::default()
+            };
+            let sizing = Sizing::build(&s, &opts.size, None).unwrap();
+            let mut mesh = TetMesh::default();
+            let mut sum = Summary::default();
+            let comm = parafront_comm::Threads::new(opts.parts);
+            let (_, held) = mesh_parts(
+                &s,
+                &fronts,
+                Some(sizing),
+                &opts,
+                &mut mesh,
+                &mut sum,
+                &comm,
+                passes_around,
+            )
+            .unwrap();
+            assert!(sum.serial_fallback.is_empty(), "{:?}", sum.serial_fallback);
+            assert_eq!(held.is_some(), size_report);
+            // The pieces were made all the same: every tet once, the
+            // torus's volume.
+            assert_eq!(sum.pieces.len(), 4);
+            let by_part: Vec<Vec<&Piece>> = sum.pieces.iter().map(|p| vec![p]).collect();
+            let vol6 = 6.0 * s.signed_volume();
+            let st = parafront_passes::check_pieces(&comm, &by_part, &s.tris, vol6).unwrap();
+            assert_eq!(
+                st.tets,
+                sum.pieces.iter().map(|p| p.tets.len()).sum::<usize>()
+            );
+            assert!(st.tets > 1000, "{}", st.tets);
+        }
     }
 }

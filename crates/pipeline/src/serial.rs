@@ -188,11 +188,11 @@ pub(crate) fn fill_whole(
 /// A region bounded by the whole surface (its ids ascending and distinct,
 /// so all of them in order) reads the surface's in place: their copies
 /// were 1.9 MB of each MPI rank through the passes on sphere_5e6.
-pub(crate) fn region_points<'a>(
-    s: &'a Surface,
-    sizing: &'a Sizing,
+pub(crate) fn region_points<'s, 'f>(
+    s: &'s Surface,
+    sizing: &'f Sizing,
     rf: &RegionFront,
-) -> (Cow<'a, [parafront_geom::P3]>, Cow<'a, [f64]>) {
+) -> (Cow<'s, [parafront_geom::P3]>, Cow<'f, [f64]>) {
     let h = sizing.surface_point_sizes();
     if rf.points.len() == s.points.len() {
         return (s.points[..].into(), h.into());
