@@ -572,10 +572,10 @@ pub fn passes_around<C: Comm>(
     let dst = redistribute::destinations(&parts, comm.owned().start, &loc, &on.base);
     // The DDG, its locator and its partitions are done with before the
     // tets move: they were 30 MB of each MPI rank's peak on sphere_5e6,
-    // which redistribution set.
+    // which redistribution set. `redistribute` returns their memory to
+    // the system, with what the caller frees before it.
     drop((on, loc));
     drop(d);
-    release(opts.release);
     Ok(Passed {
         parts,
         dst,
