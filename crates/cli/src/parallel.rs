@@ -134,27 +134,21 @@ pub(crate) fn write_partitioned_share(
             Some(*at)
         }))
         .collect();
-    // The pieces with tets: each its index in `sum.pieces`, and its region.
-    let shown: Vec<(usize, usize)> = (0..sum.pieces.len())
+    // The pieces with tets, each with its index in `sum.pieces`: piece
+    // `i` is region `i / n_held`'s piece of part `held.start + i % n_held`.
+    let ids: Vec<usize> = (0..sum.pieces.len())
         .filter(|&i| !sum.pieces[i].tets.is_empty())
-        .map(|i| (i, i / n_held))
+        .map(|i| i / n_held * parts + held.start + i % n_held)
         .collect();
-    let mut pieces: Vec<Option<_>> = std::mem::take(&mut sum.pieces)
+    let shown = std::mem::take(&mut sum.pieces)
         .into_iter()
-        .map(Some)
-        .collect();
-    let ids: Vec<usize> = shown
-        .iter()
-        .map(|&(i, r)| r * parts + held.start + i % n_held)
-        .collect();
+        .enumerate()
+        .filter(|(_, pc)| !pc.tets.is_empty());
     // Each piece's arrays are made as it is written, then dropped: a
     // process held a second copy of all its pieces here (its peak on
     // sphere_5e6 at 4 ranks).
-    let arrays = shown.iter().map(|&(i, r)| {
-        let (pc, k) = (
-            pieces[i].take().expect("each piece is written once"),
-            held.start + i % n_held,
-        );
+    let arrays = shown.map(|(i, pc)| {
+        let (r, k) = (i / n_held, held.start + i % n_held);
         let cell_base = region_base[r];
         let mut sharers = vec![0i32; pc.points.len()];
         for list in &pc.shared {

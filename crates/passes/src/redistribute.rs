@@ -851,41 +851,36 @@ mod tests {
         assert_eq!(on_boundary(&pc), want);
     }
 
-    /// A block of `n`^3 cubes of six tets each, in `np` slabs along x, one
-    /// piece a slab, its points numbered in the order its tets use them
-    /// (global ids: the block's).
+    /// A block of `n`^3 cubes of six tets each (`generate::box_mesh`), in
+    /// `np` slabs along x, one piece a slab, its points numbered in the
+    /// order its tets use them (global ids: the block's), each tet's pass
+    /// from its cube's x.
     fn slabs(n: usize, np: usize) -> Vec<Piece> {
-        let id = |x: usize, y: usize, z: usize| ((x * (n + 1) + y) * (n + 1) + z) as u32;
-        // Freudenthal's six tets of the unit cube, corners as bits xyz.
-        const KUHN: [[usize; 4]; 6] = [
-            [0, 1, 3, 7],
-            [0, 1, 5, 7],
-            [0, 2, 3, 7],
-            [0, 2, 6, 7],
-            [0, 4, 5, 7],
-            [0, 4, 6, 7],
-        ];
+        let m = parafront_mesh::generate::box_mesh(n, n, n, [0.0; 3], [n as f64; 3]);
+        // A tet's cube: its lowest corner's x (integral, up to rounding).
+        let cube_x = |t: &[parafront_mesh::PointId; 4]| {
+            t.iter()
+                .map(|p| m.points[p.idx()][0])
+                .fold(f64::INFINITY, f64::min)
+                .round() as usize
+        };
         (0..np)
             .map(|k| {
                 let mut pc = Piece::default();
                 let mut local: FxHashMap<u32, u32> = FxHashMap::default();
-                for x in k * n / np..(k + 1) * n / np {
-                    for y in 0..n {
-                        for z in 0..n {
-                            for t in KUHN {
-                                pc.tets.push(t.map(|c| {
-                                    let (a, b, d) = (x + (c >> 2), y + (c >> 1 & 1), z + (c & 1));
-                                    let g = id(a, b, d);
-                                    *local.entry(g).or_insert_with(|| {
-                                        pc.points.push([a as f64, b as f64, d as f64]);
-                                        pc.gid.push(g);
-                                        pc.points.len() as u32 - 1
-                                    })
-                                }));
-                                pc.tet_pass.push((x % 4 + 1) as u8);
-                            }
-                        }
-                    }
+                for t in m
+                    .tets
+                    .iter()
+                    .filter(|t| (k * n / np..(k + 1) * n / np).contains(&cube_x(t)))
+                {
+                    pc.tets.push(t.map(|p| {
+                        *local.entry(p.raw()).or_insert_with(|| {
+                            pc.points.push(m.points[p.idx()]);
+                            pc.gid.push(p.raw());
+                            pc.points.len() as u32 - 1
+                        })
+                    }));
+                    pc.tet_pass.push((cube_x(t) % 4 + 1) as u8);
                 }
                 pc
             })

@@ -490,8 +490,6 @@ fn mesh_sized<C: Comm>(
             passes_around,
         )?;
         if !opts.gather {
-            // Kept by regions that all went to the serial front.
-            let sizing = sizing.filter(|_| opts.size_report);
             return finish_pieces(s, &fronts, sizing, opts, comm, &inner, sum).map(Some);
         }
         opts.release();

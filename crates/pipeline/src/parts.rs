@@ -5,10 +5,12 @@ use super::*;
 use parafront_lattice::Lattice;
 use parafront_passes::{move_pieces, Piece};
 
-/// The parallel mesher (§5 to §8, `parallel`: `mesh_parallel`, or one
+/// The parallel mesher (§5 to §8, `parallel`: `passes_around`, or one
 /// that fails in tests) on each region, its parts' messages through
 /// `comm`; the merged result goes into `mesh` like the serial front's, on
-/// the process of part 0 (the others leave `mesh` as it is).
+/// the process of part 0 (the others leave `mesh` as it is). The size
+/// field `held` (`Some`) comes back where what follows needs it (a merged
+/// mesh, or the size report); the lattice's inner points with it.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn mesh_parts<C: Comm>(
     s: &Surface,
@@ -22,7 +24,8 @@ pub(crate) fn mesh_parts<C: Comm>(
 ) -> Result<(Vec<u32>, Option<Sizing>), MeshError> {
     // Pieces need the field no more once the last region's passes are
     // done, unless the report measures against it: it goes before the
-    // tets move (§8), which set each MPI rank's peak.
+    // tets move (§8), which set each MPI rank's peak; where every region
+    // went to the serial front, at the end.
     let free_field = !opts.gather && !opts.size_report;
     let holds = comm.holds(0);
     // Without the merged mesh, where each region's new points start.
@@ -191,12 +194,13 @@ pub(crate) fn mesh_parts<C: Comm>(
         sum.parallel.push(out.stats);
     }
     if sum.parallel.is_empty() {
-        return Ok((lattice_inner, held)); // every region went to the serial front
+        // Every region went to the serial front.
+        return Ok((lattice_inner, held.filter(|_| !free_field)));
     }
     for (name, x) in Stage::PARALLEL.into_iter().zip(stage) {
         sum.push(name, x);
     }
-    Ok((lattice_inner, held))
+    Ok((lattice_inner, held.filter(|_| !free_field)))
 }
 
 /// Region `rf`'s pieces (of `parts` parts) into the summary, their points'
@@ -418,6 +422,35 @@ mod tests {
     use super::*;
     use parafront_surface::generate;
 
+    /// [`mesh_parts`] of the valid surface `s` under `opts` (on a threads
+    /// comm of `opts.parts`), `parallel` making the passes, adding to
+    /// `mesh`: the field it handed back and the summary.
+    fn run_parts(
+        s: &Surface,
+        opts: &MeshOptions,
+        mesh: &mut TetMesh,
+        parallel: ParallelMesher<parafront_comm::Threads>,
+    ) -> (Option<Sizing>, Summary) {
+        let report = validate(s);
+        assert!(report.is_valid());
+        let fronts = material_regions(s, &report.shells);
+        let sizing = Sizing::build(s, &opts.size, None).unwrap();
+        let mut sum = Summary::default();
+        let comm = parafront_comm::Threads::new(opts.parts);
+        let (_, held) = mesh_parts(
+            s,
+            &fronts,
+            Some(sizing),
+            opts,
+            mesh,
+            &mut sum,
+            &comm,
+            parallel,
+        )
+        .unwrap();
+        (held, sum)
+    }
+
     /// A pass that cannot close its front must not fail the run: the
     /// region goes to the serial front, and the summary says so.
     #[test]
@@ -445,28 +478,12 @@ mod tests {
             })
         }
         let s = generate::torus([0.0; 3], 2.0, 0.7, 24, 12);
-        let report = validate(&s);
-        assert!(report.is_valid());
-        let fronts = material_regions(&s, &report.shells);
         let opts = MeshOptions {
             parts: 4,
             ..MeshOptions::default()
         };
-        let sizing = Sizing::build(&s, &opts.size, None).unwrap();
         let mut mesh = surface_mesh(&s);
-        let mut sum = Summary::default();
-        let comm = parafront_comm::Threads::new(opts.parts);
-        let (_, held) = mesh_parts(
-            &s,
-            &fronts,
-            Some(sizing),
-            &opts,
-            &mut mesh,
-            &mut sum,
-            &comm,
-            stuck,
-        )
-        .unwrap();
+        let (held, sum) = run_parts(&s, &opts, &mut mesh, stuck);
         // A merged run keeps its field for what follows the passes.
         assert!(held.is_some());
         assert_eq!(sum.serial_fallback.len(), 1);
@@ -482,8 +499,6 @@ mod tests {
     #[test]
     fn pieces_free_the_field_before_redistribution_unless_the_report_wants_it() {
         let s = generate::torus([0.0; 3], 2.0, 0.7, 48, 24);
-        let report = validate(&s);
-        let fronts = material_regions(&s, &report.shells);
         for size_report in [false, true] {
             let opts = MeshOptions {
                 parts: 4,
@@ -491,21 +506,7 @@ mod tests {
                 size_report,
                 ..MeshOptions::default()
             };
-            let sizing = Sizing::build(&s, &opts.size, None).unwrap();
-            let mut mesh = TetMesh::default();
-            let mut sum = Summary::default();
-            let comm = parafront_comm::Threads::new(opts.parts);
-            let (_, held) = mesh_parts(
-                &s,
-                &fronts,
-                Some(sizing),
-                &opts,
-                &mut mesh,
-                &mut sum,
-                &comm,
-                passes_around,
-            )
-            .unwrap();
+            let (held, sum) = run_parts(&s, &opts, &mut TetMesh::default(), passes_around);
             assert!(sum.serial_fallback.is_empty(), "{:?}", sum.serial_fallback);
             assert_eq!(held.is_some(), size_report);
             // The pieces were made all the same: every tet once, the
@@ -513,6 +514,7 @@ mod tests {
             assert_eq!(sum.pieces.len(), 4);
             let by_part: Vec<Vec<&Piece>> = sum.pieces.iter().map(|p| vec![p]).collect();
             let vol6 = 6.0 * s.signed_volume();
+            let comm = parafront_comm::Threads::new(opts.parts);
             let st = parafront_passes::check_pieces(&comm, &by_part, &s.tris, vol6).unwrap();
             assert_eq!(
                 st.tets,
