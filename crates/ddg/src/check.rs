@@ -11,7 +11,7 @@ impl Ddg {
         let mesh = TetMesh {
             points: self.points.clone(),
             tets: self.tets.iter().map(|t| t.map(PointId::from_raw)).collect(),
-            neigh: self.neigh.clone(),
+            neigh: self.neigh().to_vec(),
             ..TetMesh::default()
         };
         mesh.check().map(|_| ())
@@ -32,12 +32,12 @@ mod tests {
         assert!(d.tets.len() > 100);
         assert!(d.check().is_ok());
         let fr = d
-            .neigh
+            .neigh()
             .iter()
             .position(|n| !n.is_none())
             .expect("inner faces");
         let mut bad = d.clone();
-        bad.neigh[fr] = NO_FACE;
+        bad.adjacency.get_mut()[fr] = NO_FACE;
         let e = bad.check().unwrap_err();
         assert!(e.count(ProblemKind::NeighWrong) >= 1, "{e}");
         let mut bad = d.clone();
@@ -45,7 +45,7 @@ mod tests {
         let e = bad.check().unwrap_err();
         assert!(e.count(ProblemKind::NotPositive) >= 1, "{e}");
         let mut bad = d.clone();
-        bad.neigh.pop();
+        bad.adjacency.get_mut().pop();
         let e = bad.check().unwrap_err();
         assert!(e.count(ProblemKind::ArrayLength) >= 1, "{e}");
     }

@@ -6,12 +6,14 @@
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
+mod adjacency;
 mod check;
 mod field;
 mod filter;
 mod locate;
 mod partition;
 
+pub use adjacency::{Adjacency, Neigh};
 pub use field::GradedField;
 
 pub use filter::{Interfaces, PartFilter};
@@ -23,7 +25,6 @@ pub use partition::{
 
 use parafront_front::{advance, Everywhere, FrontError, FrontInput, FrontOptions, SizeMode};
 use parafront_geom::P3;
-use parafront_mesh::FaceRef;
 use std::time::Instant;
 
 /// Default growth factor `c_i` (§5: typical values 1.5 to 1.7).
@@ -37,8 +38,8 @@ pub struct Ddg {
     pub points: Vec<P3>,
     /// Point ids of each tet, as the front made them.
     pub tets: Vec<[u32; 4]>,
-    /// The tet across each face, `neigh[4t+f]` (or `NO_FACE`).
-    pub neigh: Vec<FaceRef>,
+    /// The tet across each face: [`Ddg::neigh`].
+    pub adjacency: Adjacency,
     /// Points of the input front.
     pub n_input: usize,
     /// The growth factor.
@@ -86,7 +87,7 @@ pub fn build(
     let d = Ddg {
         points: r.points,
         tets: r.tets,
-        neigh: r.neigh,
+        adjacency: r.neigh.into(),
         n_input,
         growth: c,
         seconds: t0.elapsed().as_secs_f64(),

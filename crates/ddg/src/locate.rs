@@ -245,41 +245,42 @@ fn holds(q: &[P3; 4], p: P3) -> Option<bool> {
 
 /// Which DDG tets hold a point (closed tets, exact predicates).
 ///
-/// It borrows the DDG, keeps the tets' boxes on a 16-bit grid over the
+/// It borrows the DDG, keeps the tets' boxes on an 8-bit grid over the
 /// DDG's box and bins them one tet per cell on average, each tet only in
 /// the cells no face plane of it cuts off: every process holds a locator
 /// through the passes, and on sphere_5e6's DDG (184k tets) copies, f64
 /// boxes and finer bins by box alone were 34 MB of each MPI rank's 125 MB
-/// heap (13 MB with f32 boxes, 10.5 MB now).
+/// heap (13 MB with f32 boxes, 10.5 MB with 16-bit ones). The boxes only
+/// spare the exact test most tets of a bin: coarser ones cost no time.
 #[derive(Clone, Debug)]
 pub struct Locator<'a> {
     bins: Bins,
-    grid: Grid16,
+    grid: Grid8,
     /// Each tet's box on the grid, rounded outwards: `[min, max]`.
-    boxes: Vec<[[u16; 3]; 2]>,
+    boxes: Vec<[[u8; 3]; 2]>,
     d: &'a Ddg,
 }
 
-/// Coordinates scaled onto `[0, 65533]` over a box. Rounding is monotone,
+/// Coordinates scaled onto `[0, 253]` over a box. Rounding is monotone,
 /// so a point of a box lies between the box's corners scaled, floor and
 /// ceiling: the scaled boxes hold every point their boxes hold.
 #[derive(Clone, Debug)]
-struct Grid16 {
+struct Grid8 {
     min: P3,
     scale: [f64; 3],
 }
 
-impl Grid16 {
-    fn new(b: &Aabb) -> Grid16 {
+impl Grid8 {
+    fn new(b: &Aabb) -> Grid8 {
         let scale = [0, 1, 2].map(|k| {
             let e = b.max[k] - b.min[k];
             if e > 0.0 && e.is_finite() {
-                65533.0 / e
+                253.0 / e
             } else {
                 0.0
             }
         });
-        Grid16 { min: b.min, scale }
+        Grid8 { min: b.min, scale }
     }
 
     #[inline]
@@ -288,9 +289,9 @@ impl Grid16 {
     }
 
     /// The box `b` on the grid (rounded outwards).
-    fn scaled(&self, b: &Aabb) -> [[u16; 3]; 2] {
+    fn scaled(&self, b: &Aabb) -> [[u8; 3]; 2] {
         let (lo, hi) = (self.at(b.min), self.at(b.max));
-        let q = |x: f64| x.clamp(0.0, 65535.0) as u16;
+        let q = |x: f64| x.clamp(0.0, 255.0) as u8;
         [lo.map(|x| q(x.floor())), hi.map(|x| q(x.ceil()))]
     }
 }
@@ -312,7 +313,7 @@ impl<'a> Locator<'a> {
             |faces, cell| !faces.beyond(cell),
             per_cell,
         );
-        let grid = Grid16::new(&Aabb::from_points(d.points.iter()));
+        let grid = Grid8::new(&Aabb::from_points(d.points.iter()));
         let boxes = (0..d.tets.len())
             .map(|t| grid.scaled(&Aabb::from_points(d.tet_points(t).iter())))
             .collect();
@@ -326,7 +327,7 @@ impl<'a> Locator<'a> {
 
     /// Bytes the locator holds beside the DDG.
     pub fn heap_bytes(&self) -> usize {
-        self.bins.heap_bytes() + 12 * self.boxes.capacity()
+        self.bins.heap_bytes() + 6 * self.boxes.capacity()
     }
 
     /// Whether the box of tet `t` holds the point at `g` on the grid.
@@ -377,7 +378,7 @@ impl<'a> Locator<'a> {
     /// Whether `t` is a tet id (a hint may be `u32::MAX`) that holds `p`
     /// strictly.
     #[inline]
-    fn holds_alone(&self, t: u32, p: P3) -> bool {
+    pub(crate) fn holds_alone(&self, t: u32, p: P3) -> bool {
         (t as usize) < self.d.tets.len()
             && self.in_box(t, self.grid.at(p))
             && self.strictly_holds(t, p)
@@ -389,41 +390,6 @@ impl<'a> Locator<'a> {
     /// not depend on the hint.
     pub fn owner_near(&self, p: P3, part: &[u32], hint: &AtomicU32) -> Option<u32> {
         self.owner_placed(p, part, hint).0
-    }
-
-    /// The tet that holds `p` strictly, found by walking from tet `t`
-    /// through face neighbours towards `p` (across the first face that has
-    /// `p` outside), over at most `steps` tets; `None` where the walk ends
-    /// otherwise: on a face, outside the DDG or out of steps.
-    pub(crate) fn walk(&self, mut t: u32, p: P3, steps: usize) -> Option<u32> {
-        for _ in 0..steps {
-            if t as usize >= self.d.tets.len() {
-                return None;
-            }
-            let q = self.corners(t);
-            let mut strict = true;
-            let mut exit = None;
-            for k in 0..4 {
-                // Face k is opposite corner k.
-                let mut r = q;
-                r[k] = p;
-                let o = orient3d(r[0], r[1], r[2], r[3]);
-                if o < 0.0 {
-                    exit = Some(k);
-                    break;
-                }
-                strict &= o > 0.0;
-            }
-            let Some(k) = exit else {
-                return strict.then_some(t);
-            };
-            let n = self.d.neigh[4 * t as usize + k];
-            if n.is_none() {
-                return None;
-            }
-            t = n.tet().idx() as u32;
-        }
-        None
     }
 
     /// [`Locator::owner_near`], and the tet that holds `p` strictly when
@@ -504,11 +470,11 @@ impl<'a> Locator<'a> {
     /// The lowest part among the DDG tets touching `p` (§8), or `None`
     /// outside the DDG. `hint` is a tet near `p` (or `u32::MAX`), updated
     /// to the tet found holding `p` strictly (else `u32::MAX`): the answer
-    /// does not depend on it. A walk from it goes first.
+    /// does not depend on it. Walks from it through the face neighbours
+    /// saved no time (sphere_5e6 at 32 parts), and would hold them.
     pub fn lowest_host(&self, p: P3, part: &[u32], hint: &mut u32) -> Option<u32> {
-        if let Some(t) = self.walk(*hint, p, WALK_STEPS) {
-            *hint = t;
-            return Some(part[t as usize]);
+        if self.holds_alone(*hint, p) {
+            return Some(part[*hint as usize]);
         }
         *hint = u32::MAX;
         let mut lo: Option<u32> = None;
@@ -523,9 +489,6 @@ impl<'a> Locator<'a> {
         lo
     }
 }
-
-/// Tets a walk from a nearby point's tet visits before the bins decide.
-pub(crate) const WALK_STEPS: usize = 4;
 
 #[cfg(test)]
 mod tests {
@@ -657,18 +620,19 @@ mod tests {
     }
 
     /// The part filter's `locate`, from any hints, answers as `point_ok`,
-    /// and the place it gives holds the point strictly; a walk ends only at
-    /// such a tet; `edge_ok_at` answers as `edge_ok`.
+    /// and the place it gives holds the point strictly, without the DDG's
+    /// face neighbours; `edge_ok_at` answers as `edge_ok`.
     #[test]
     fn hinted_location_answers_as_the_bins() {
         let d = torus_ddg();
         let loc = Locator::new(&d);
         let part: Vec<u32> = (0..d.tets.len() as u32).map(|t| (t / 7) % 5).collect();
         let walls = Interfaces::new(&d, &part, 0..5);
+        d.let_go_neigh();
         let f = PartFilter::new(&loc, &walls, &part, 2);
         let probes = probes(&d);
         let n = d.tets.len() as u32;
-        let (mut walked, mut placed) = (0, 0);
+        let mut placed = 0;
         let mut at = Vec::new();
         for (i, &p) in probes.iter().enumerate() {
             // Hints: the host of the previous probe, a tet far off, none.
@@ -683,15 +647,10 @@ mod tests {
                 assert!(loc.strictly_holds(t, p), "place of {p:?}");
                 placed += 1;
             }
-            for &h in &near[..2] {
-                if let Some(w) = loc.walk(h, p, WALK_STEPS) {
-                    assert!(loc.strictly_holds(w, p), "walk to {p:?}");
-                    walked += 1;
-                }
-            }
             at.push(t);
         }
-        assert!(walked > 100 && placed > 1000, "{walked} {placed}");
+        assert!(placed > 1000, "{placed}");
+        assert!(!d.holds_neigh(), "the filter asked for the neighbours");
         for i in 1..probes.len() {
             let (a, b) = (probes[i - 1], probes[i]);
             assert_eq!(f.edge_ok_at(a, at[i - 1], b, at[i]), f.edge_ok(a, b));
@@ -736,7 +695,7 @@ mod tests {
             min: [-3.7, 0.1, 1e3],
             max: [2.9, 0.1000001, 1e3 + 1e-9],
         };
-        let g = Grid16::new(&all);
+        let g = Grid8::new(&all);
         let mut misses = 0;
         for _ in 0..20000 {
             let at = |t: f64, k: usize| all.min[k] + t * (all.max[k] - all.min[k]);

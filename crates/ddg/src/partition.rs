@@ -245,12 +245,13 @@ pub fn shift_loads(d: &Ddg, part: &[u32], left: &[u32], layers: usize, parts: us
 /// The DDG's dual graph in CSR form (METIS's `xadj`, `adjncy`): one vertex
 /// per tet, one edge per interior face, in tet and face order.
 pub(crate) fn dual_graph(d: &Ddg) -> (Vec<i32>, Vec<i32>) {
+    let neigh = d.neigh();
     let mut xadj = Vec::with_capacity(d.tets.len() + 1);
     let mut adj = Vec::with_capacity(4 * d.tets.len());
     xadj.push(0);
     for t in 0..d.tets.len() {
         for f in 0..4 {
-            let n = d.neigh[4 * t + f];
+            let n = neigh[4 * t + f];
             if !n.is_none() {
                 adj.push(n.tet().raw() as i32);
             }
@@ -308,6 +309,7 @@ pub(crate) fn metis_kway(
     h: &(dyn Fn(P3) -> f64 + Sync),
     parts: usize,
 ) -> Vec<u32> {
+    let neigh = d.neigh();
     let n = d.tets.len();
     if parts <= 1 || n <= parts {
         return rcb(d, w, parts);
@@ -329,7 +331,7 @@ pub(crate) fn metis_kway(
         .map(|t| {
             let mut x = [0.0; 4];
             for (f, xf) in x.iter_mut().enumerate() {
-                let nb = d.neigh[4 * t + f];
+                let nb = neigh[4 * t + f];
                 if !nb.is_none() && nb.tet().idx() > t {
                     *xf = fine_faces(d, h, t, f);
                 }
@@ -340,7 +342,7 @@ pub(crate) fn metis_kway(
     let mut ew = Vec::with_capacity(adj.len());
     for t in 0..n {
         for f in 0..4 {
-            let nb = d.neigh[4 * t + f];
+            let nb = neigh[4 * t + f];
             if !nb.is_none() {
                 let (u, g) = (nb.tet().idx(), nb.local());
                 ew.push(if u > t { fw[t][f] } else { fw[u][g] });
@@ -381,10 +383,11 @@ pub(crate) fn metis_kway(
 
 /// DDG faces between tets of different parts (the cut of the dual graph).
 pub fn cut_faces(d: &Ddg, part: &[u32]) -> usize {
+    let neigh = d.neigh();
     let mut cut = 0;
     for t in 0..d.tets.len() {
         for f in 0..4 {
-            let n = d.neigh[4 * t + f];
+            let n = neigh[4 * t + f];
             if !n.is_none() && (n.tet().idx()) > t && part[n.tet().idx()] != part[t] {
                 cut += 1;
             }
@@ -396,10 +399,11 @@ pub fn cut_faces(d: &Ddg, part: &[u32]) -> usize {
 /// The fine faces that will lie on the walls between parts: the cut
 /// faces weighted by their area over the fine size squared.
 pub fn cut_fine_faces(d: &Ddg, part: &[u32], h: &(dyn Fn(P3) -> f64 + Sync)) -> f64 {
+    let neigh = d.neigh();
     let mut cut = 0.0;
     for t in 0..d.tets.len() {
         for f in 0..4 {
-            let n = d.neigh[4 * t + f];
+            let n = neigh[4 * t + f];
             if !n.is_none() && (n.tet().idx()) > t && part[n.tet().idx()] != part[t] {
                 cut += fine_faces(d, h, t, f);
             }
@@ -411,6 +415,7 @@ pub fn cut_fine_faces(d: &Ddg, part: &[u32], h: &(dyn Fn(P3) -> f64 + Sync)) -> 
 /// Per part, how many face-connected pieces its tets make (1 for a
 /// connected part, 0 for an empty one).
 pub fn components(d: &Ddg, part: &[u32], parts: usize) -> Vec<usize> {
+    let neigh = d.neigh();
     let n = d.tets.len();
     let mut seen = vec![false; n];
     let mut count = vec![0usize; parts];
@@ -425,7 +430,7 @@ pub fn components(d: &Ddg, part: &[u32], parts: usize) -> Vec<usize> {
         stack.push(s);
         while let Some(t) = stack.pop() {
             for f in 0..4 {
-                let nb = d.neigh[4 * t + f];
+                let nb = neigh[4 * t + f];
                 if nb.is_none() {
                     continue;
                 }
@@ -629,6 +634,7 @@ mod tests {
     #[test]
     fn shifts_work_on_the_metis_partition() {
         let d = torus_ddg();
+        let neigh = d.neigh();
         let h = |_p: P3| 0.05;
         let w = tet_weights(&d, &h);
         let part = metis_kway(&d, &w, &h, 8);
@@ -644,7 +650,7 @@ mod tests {
                 let mut v = Vec::new();
                 for t in 0..d.tets.len() {
                     for f in 0..4 {
-                        let n = d.neigh[4 * t + f];
+                        let n = neigh[4 * t + f];
                         if !n.is_none() && (n.tet().idx()) > t && p[n.tet().idx()] != p[t] {
                             v.push((t, f));
                         }
@@ -675,6 +681,7 @@ mod tests {
     #[test]
     fn the_order_for_a_shift_shares_out_the_front_left() {
         let d = sphere_ddg();
+        let neigh = d.neigh();
         let h = |_p: P3| 0.05;
         let w = tet_weights(&d, &h);
         // A front left along the walls: one face per tet beside a wall.
@@ -684,7 +691,7 @@ mod tests {
                 .map(|t| {
                     (0..4)
                         .filter(|&f| {
-                            let n = d.neigh[4 * t + f];
+                            let n = neigh[4 * t + f];
                             !n.is_none() && raw[n.tet().idx()] != raw[t]
                         })
                         .count() as u32

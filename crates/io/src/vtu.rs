@@ -32,6 +32,9 @@ pub enum FieldData<'a> {
     I32(&'a [i32]),
     /// `Int64` values.
     I64(&'a [i64]),
+    /// `Int64` values, each a `u32` plus the offset: ids kept as `u32`
+    /// are written without a wider copy.
+    I64From(&'a [u32], i64),
     /// For markers such as `vtkGhostType`.
     U8(&'a [u8]),
 }
@@ -42,6 +45,7 @@ impl FieldData<'_> {
             FieldData::F64(s) => s.len(),
             FieldData::I32(s) => s.len(),
             FieldData::I64(s) => s.len(),
+            FieldData::I64From(s, _) => s.len(),
             FieldData::U8(s) => s.len(),
         }
     }
@@ -179,6 +183,7 @@ fn field_src<'a>(f: &Field<'a>, n: usize) -> Box<dyn Source + 'a> {
         FieldData::F64(s) => src(n, move |i| if i < len { s[i] } else { f64::NAN }),
         FieldData::I32(s) => src(n, move |i| if i < len { s[i] } else { -1 }),
         FieldData::I64(s) => src(n, move |i| if i < len { s[i] } else { -1 }),
+        FieldData::I64From(s, o) => src(n, move |i| if i < len { o + s[i] as i64 } else { -1 }),
         FieldData::U8(s) => src(n, move |i| if i < len { s[i] } else { 0 }),
     }
 }

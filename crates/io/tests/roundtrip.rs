@@ -399,3 +399,33 @@ mod prop {
         }
     }
 }
+
+/// `u32` ids plus an offset are written as the `Int64` array of their
+/// sums, byte for byte, cell arrays padded over the triangles alike.
+#[test]
+fn ids_from_u32_write_as_their_int64_sums() {
+    let d = scratch("i64from");
+    let m = mesh();
+    let ids: Vec<u32> = (0..m.points.len() as u32).map(|i| 7 * i).collect();
+    let cells: Vec<u32> = (0..m.tets.len() as u32).rev().collect();
+    let wide = |v: &[u32], o: i64| v.iter().map(|&x| o + x as i64).collect::<Vec<i64>>();
+    let (ids64, cells64) = (wide(&ids, 0), wide(&cells, 1 << 40));
+    let write = |name: &str, p: FieldData, c: FieldData| {
+        let piece = Piece {
+            mesh: &m,
+            point_fields: vec![Field::scalar("GlobalPointIds", p)],
+            cell_fields: vec![Field::scalar("GlobalCellIds", c)],
+        };
+        let path = d.join(name);
+        write_vtu(&path, &piece, &WriteOptions::default()).unwrap();
+        std::fs::read(&path).unwrap()
+    };
+    let a = write("a.vtu", FieldData::I64(&ids64), FieldData::I64(&cells64));
+    let b = write(
+        "b.vtu",
+        FieldData::I64From(&ids, 0),
+        FieldData::I64From(&cells, 1 << 40),
+    );
+    assert!(!m.bnd_tris.is_empty(), "the cell arrays are padded");
+    assert_eq!(a, b);
+}

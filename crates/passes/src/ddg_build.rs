@@ -430,7 +430,7 @@ pub(crate) fn build_ddg_at<C: Comm>(
         Ddg {
             points: pts,
             tets,
-            neigh,
+            adjacency: neigh.into(),
             n_input: points.len(),
             growth: c,
             seconds: t_all.elapsed().as_secs_f64(),
@@ -500,9 +500,8 @@ fn merge_parts(
     for t in &mut tets {
         *t = t.map(|g| map[g as usize]);
     }
-    let typed: Vec<[PointId; 4]> = tets.iter().map(|t| t.map(PointId::from_raw)).collect();
-    let neigh = parafront_mesh::face_neighbours(&typed).map_err(PassError::DdgMerge)?;
-    drop(typed);
+    let typed: &[[PointId; 4]] = bytemuck::cast_slice(&tets);
+    let neigh = parafront_mesh::face_neighbours(typed).map_err(PassError::DdgMerge)?;
     Ok((pts, tets, neigh))
 }
 

@@ -367,6 +367,7 @@ pub(crate) fn seed_inner_parts(
     // Parts that own a face of the input front.
     let mut owns = vec![false; np];
     let owner: Vec<Option<u32>> = points.par_iter().map(|&p| loc.owner(p, part0)).collect();
+    let neigh = d.neigh();
     for f in faces {
         let o = f.map(|i| owner[i as usize]);
         if let Some(k) = o[0] {
@@ -377,7 +378,7 @@ pub(crate) fn seed_inner_parts(
     }
     for t in 0..nt {
         let wall = (0..4).any(|f| {
-            let n = d.neigh[4 * t + f];
+            let n = neigh[4 * t + f];
             n.is_none() || part0[n.tet().idx()] != part0[t]
         });
         if wall {
@@ -387,7 +388,7 @@ pub(crate) fn seed_inner_parts(
     }
     while let Some(t) = queue.pop_front() {
         for f in 0..4 {
-            let n = d.neigh[4 * t + f];
+            let n = neigh[4 * t + f];
             if !n.is_none() && depth[n.tet().idx()] == u32::MAX {
                 depth[n.tet().idx()] = depth[t] + 1;
                 queue.push_back(n.tet().idx());

@@ -307,8 +307,8 @@ pub(crate) fn destinations(
         .map(|(i, part)| {
             let k = start + i;
             // Each point's lowest part, and the DDG tet that holds it
-            // strictly where one does: a walk for a tet's next corner
-            // starts there (the points' own order jumps about).
+            // strictly where one does: a tet's next corner tries it first
+            // (the points' own order jumps about).
             let mut host: Vec<Option<u32>> = vec![None; part.pts.len()];
             let mut place = vec![u32::MAX; part.pts.len()];
             let dst: Vec<u32> = part

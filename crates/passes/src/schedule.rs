@@ -238,6 +238,10 @@ impl<C: Comm> Passes<'_, C> {
             part_of,
             cells: crate::reach::PartCells::new(self.d, part_of, self.comm.parts()),
         };
+        // The fronts do not walk the DDG: its face neighbours are rebuilt
+        // when the next partition or §8 asks for them.
+        self.d.let_go_neigh();
+        crate::release(self.opts.release);
         let size = Sizes::fine(self.size);
         let (tets, secs) = parallel_pass(
             parts,

@@ -273,11 +273,12 @@ fn the_ddg_built_in_parallel_is_valid_and_does_not_depend_on_the_threads() {
         let want = s.signed_volume().abs();
         assert!((vol - want).abs() < 1e-9 * want, "{vol} vs {want}");
         // Its face neighbours match the mesh's.
+        let neigh = a.neigh();
         for (t, tv) in a.tets.iter().enumerate() {
             for f in 0..4 {
-                let n = a.neigh[4 * t + f];
+                let n = neigh[4 * t + f];
                 if !n.is_none() {
-                    assert_eq!(a.neigh[n.idx()].raw(), (4 * t + f) as u32);
+                    assert_eq!(neigh[n.idx()].raw(), (4 * t + f) as u32);
                     let u = a.tets[n.tet().idx()];
                     let shared = tv.iter().filter(|p| u.contains(p)).count();
                     assert_eq!(shared, 3);

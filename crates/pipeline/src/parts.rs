@@ -14,7 +14,7 @@ use parafront_passes::{move_pieces, Piece};
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn mesh_parts<C: Comm>(
     s: &Surface,
-    fronts: &[RegionFront],
+    fronts: &mut [RegionFront],
     mut held: Option<Sizing>,
     opts: &MeshOptions,
     mesh: &mut TetMesh,
@@ -54,7 +54,8 @@ pub(crate) fn mesh_parts<C: Comm>(
     };
     // Seconds of each of `Stage::PARALLEL`, summed over the regions.
     let mut stage = [0.0f64; Stage::PARALLEL.len()];
-    for (ri, rf) in fronts.iter().enumerate() {
+    let n_regions = fronts.len();
+    for (ri, rf) in fronts.iter_mut().enumerate() {
         // Freed only after the last region's passes.
         let Some(sizing) = held.as_ref() else { break };
         let field = |p| sizing.size(p);
@@ -82,7 +83,12 @@ pub(crate) fn mesh_parts<C: Comm>(
         let around = (&core[..], &core_tets[..]);
         let passed = parallel(&pts, &hs, &rf.faces, around, &field, &popts, comm);
         drop(hs);
-        let last = ri + 1 == fronts.len();
+        let last = ri + 1 == n_regions;
+        if passed.is_ok() && !opts.gather {
+            // The fallback below is the last to read them (the region's
+            // volume was taken before).
+            rf.faces = Vec::new();
+        }
         let passed = match passed {
             Ok(p) if free_field && last => {
                 held = None;
@@ -314,14 +320,32 @@ type ParallelMesher<C> = fn(
     &C,
 ) -> Result<Passed, PassError>;
 
+/// Six times the volume of the regions `fronts` bound (normals inward).
+pub(crate) fn volume6(s: &Surface, fronts: &[RegionFront]) -> f64 {
+    fronts
+        .iter()
+        .map(|rf| {
+            let p = |i: u32| s.points[rf.points[i as usize] as usize];
+            let o = rf.faces.first().map_or([0.0; 3], |f| p(f[0]));
+            rf.faces
+                .iter()
+                .map(|f| parafront_geom::tet_volume6(o, p(f[0]), p(f[2]), p(f[1])))
+                .sum::<f64>()
+                .abs()
+        })
+        .sum()
+}
+
 /// The end of a partitioned run (`gather` off): the pieces improved,
 /// checked and measured where they lie, the counts summed over the
-/// processes; the mesh is empty. `lattice_inner`: the global ids of the
-/// lattice's inner points, which improvement leaves alone. `sizing`: the
-/// field, where the quality report measures the sizes against it.
+/// processes; the mesh is empty. `fronts`: the regions (their faces gone
+/// after their passes), which bound six times `vol6`. `lattice_inner`: the
+/// global ids of the lattice's inner points, which improvement leaves
+/// alone. `sizing`: the field, where the quality report measures the
+/// sizes against it.
 pub(crate) fn finish_pieces<C: Comm>(
     s: &Surface,
-    fronts: &[RegionFront],
+    (fronts, vol6): (&[RegionFront], f64),
     sizing: Option<Sizing>,
     opts: &MeshOptions,
     comm: &C,
@@ -379,19 +403,6 @@ pub(crate) fn finish_pieces<C: Comm>(
     for (i, pc) in sum.pieces.iter().enumerate() {
         by_part[i % held.max(1)].push(pc);
     }
-    // Six times each region's volume, as its front (normals inward) bounds it.
-    let vol6: f64 = fronts
-        .iter()
-        .map(|rf| {
-            let p = |i: u32| s.points[rf.points[i as usize] as usize];
-            let o = rf.faces.first().map_or([0.0; 3], |f| p(f[0]));
-            rf.faces
-                .iter()
-                .map(|f| parafront_geom::tet_volume6(o, p(f[0]), p(f[2]), p(f[1])))
-                .sum::<f64>()
-                .abs()
-        })
-        .sum();
     let tets = if opts.no_check {
         comm.all_reduce(
             by_part
@@ -424,22 +435,23 @@ mod tests {
 
     /// [`mesh_parts`] of the valid surface `s` under `opts` (on a threads
     /// comm of `opts.parts`), `parallel` making the passes, adding to
-    /// `mesh`: the field it handed back and the summary.
+    /// `mesh`: the field it handed back, the summary and the fronts as it
+    /// left them.
     fn run_parts(
         s: &Surface,
         opts: &MeshOptions,
         mesh: &mut TetMesh,
         parallel: ParallelMesher<parafront_comm::Threads>,
-    ) -> (Option<Sizing>, Summary) {
+    ) -> (Option<Sizing>, Summary, Vec<RegionFront>) {
         let report = validate(s);
         assert!(report.is_valid());
-        let fronts = material_regions(s, &report.shells);
+        let mut fronts = material_regions(s, &report.shells);
         let sizing = Sizing::build(s, &opts.size, None).unwrap();
         let mut sum = Summary::default();
         let comm = parafront_comm::Threads::new(opts.parts);
         let (_, held) = mesh_parts(
             s,
-            &fronts,
+            &mut fronts,
             Some(sizing),
             opts,
             mesh,
@@ -448,7 +460,7 @@ mod tests {
             parallel,
         )
         .unwrap();
-        (held, sum)
+        (held, sum, fronts)
     }
 
     /// A pass that cannot close its front must not fail the run: the
@@ -483,9 +495,11 @@ mod tests {
             ..MeshOptions::default()
         };
         let mut mesh = surface_mesh(&s);
-        let (held, sum) = run_parts(&s, &opts, &mut mesh, stuck);
-        // A merged run keeps its field for what follows the passes.
+        let (held, sum, fronts) = run_parts(&s, &opts, &mut mesh, stuck);
+        // A merged run keeps its field for what follows the passes, and
+        // the fallback had the front.
         assert!(held.is_some());
+        assert!(fronts.iter().all(|rf| !rf.faces.is_empty()));
         assert_eq!(sum.serial_fallback.len(), 1);
         assert_eq!(sum.serial_fallback[0].0, 1);
         assert!(sum.serial_fallback[0].1.contains("pass 4"));
@@ -496,9 +510,15 @@ mod tests {
         assert!((v - s.signed_volume()).abs() < 1e-9 * v, "{v}");
     }
 
+    /// Pieces free the field before redistribution (unless the report
+    /// wants it) and the fronts' faces; the volume they are checked
+    /// against is taken before.
     #[test]
     fn pieces_free_the_field_before_redistribution_unless_the_report_wants_it() {
         let s = generate::torus([0.0; 3], 2.0, 0.7, 48, 24);
+        let vol6 = 6.0 * s.signed_volume();
+        let fronts = material_regions(&s, &validate(&s).shells);
+        assert!((volume6(&s, &fronts) - vol6).abs() < 1e-9 * vol6);
         for size_report in [false, true] {
             let opts = MeshOptions {
                 parts: 4,
@@ -506,14 +526,14 @@ mod tests {
                 size_report,
                 ..MeshOptions::default()
             };
-            let (held, sum) = run_parts(&s, &opts, &mut TetMesh::default(), passes_around);
+            let (held, sum, fronts) = run_parts(&s, &opts, &mut TetMesh::default(), passes_around);
             assert!(sum.serial_fallback.is_empty(), "{:?}", sum.serial_fallback);
             assert_eq!(held.is_some(), size_report);
+            assert!(fronts.iter().all(|rf| rf.faces.is_empty()));
             // The pieces were made all the same: every tet once, the
             // torus's volume.
             assert_eq!(sum.pieces.len(), 4);
             let by_part: Vec<Vec<&Piece>> = sum.pieces.iter().map(|p| vec![p]).collect();
-            let vol6 = 6.0 * s.signed_volume();
             let comm = parafront_comm::Threads::new(opts.parts);
             let st = parafront_passes::check_pieces(&comm, &by_part, &s.tris, vol6).unwrap();
             assert_eq!(

@@ -34,7 +34,10 @@ use crate::share::{Alone, OctreeShare, Subtree};
 use parafront_geom::{dist, P3};
 use rayon::prelude::*;
 
+mod near;
 mod query;
+
+use near::NearLists;
 
 /// Cells with a seed closer than this many cell sizes are near leaves.
 const NEAR_FACTOR: f64 = 1.0;
@@ -176,10 +179,8 @@ pub struct SurfaceGrowth {
     root_lo: P3,
     root_s: f64,
     nodes: Vec<u32>,
-    /// (start, len) into `cand` per near leaf.
-    near: Vec<(u32, u32)>,
-    /// Seed indices of the near leaves.
-    cand: Vec<u32>,
+    /// The near leaves' seed ids.
+    near: NearLists,
     far: Vec<[f64; 8]>,
     stats: GrowthStats,
 }
@@ -275,8 +276,7 @@ impl SurfaceGrowth {
             root_lo,
             root_s,
             nodes: vec![0],
-            near: Vec::new(),
-            cand: Vec::new(),
+            near: NearLists::default(),
             far: Vec::new(),
             stats: GrowthStats {
                 seeds: seeds.len(),
@@ -485,29 +485,27 @@ impl SurfaceGrowth {
             .collect();
         let subs = share.gather(mine, n);
         assert_eq!(subs.len(), n, "every subtree of the frontier");
+        let total = |f: fn(&Subtree) -> usize| subs.iter().chain([&top]).map(f).sum::<usize>();
+        self.near = NearLists::default();
+        self.near
+            .reserve(total(|t| t.near.len()), total(|t| t.cand.len()));
+        self.add_near(&top);
         self.nodes = top.nodes;
-        self.near = top.near;
-        self.cand = top.cand;
         self.far = top.far;
         self.stats.depth = top.depth;
         let total = |f: fn(&Subtree) -> usize| subs.iter().map(f).sum::<usize>();
         self.nodes.reserve_exact(total(|t| t.nodes.len()));
-        self.near.reserve_exact(total(|t| t.near.len()));
-        self.cand.reserve_exact(total(|t| t.cand.len()));
         self.far.reserve_exact(total(|t| t.far.len()));
         for (node, sub) in frontier.into_iter().zip(subs) {
             self.stitch(node, sub);
         }
         let st = &mut self.stats;
         st.nodes = self.nodes.len();
-        st.near_leaves = self.near.len();
+        st.near_leaves = self.near.leaves.len();
         st.far_leaves = self.far.len();
-        st.candidates = self.cand.len();
-        st.bytes = self.nodes.len() * 4
-            + self.near.len() * 8
-            + self.cand.len() * 4
-            + self.far.len() * 64
-            + self.seeds.len() * 32;
+        st.candidates = self.near.ids;
+        st.bytes =
+            self.nodes.len() * 4 + self.near.bytes() + self.far.len() * 64 + self.seeds.len() * 32;
     }
 
     /// The subtree under frontier cell `root`, depth first, at most about
@@ -533,11 +531,7 @@ impl SurfaceGrowth {
     /// the octree's.
     fn stitch(&mut self, node: usize, sub: Subtree) {
         let base = self.nodes.len() as u32;
-        let (near0, cand0, far0) = (
-            self.near.len() as u32,
-            self.cand.len() as u32,
-            self.far.len() as u32,
-        );
+        let (near0, far0) = (self.near.leaves.len() as u32, self.far.len() as u32);
         let remap = |code: u32| match code >> KIND_SHIFT {
             K_INTERNAL => base + code - 1,
             K_NEAR => (K_NEAR << KIND_SHIFT) | ((code & IDX_MASK) + near0),
@@ -545,11 +539,16 @@ impl SurfaceGrowth {
         };
         self.nodes[node] = remap(sub.nodes[0]);
         self.nodes.extend(sub.nodes[1..].iter().map(|&c| remap(c)));
-        self.near
-            .extend(sub.near.iter().map(|&(a, l)| (a + cand0, l)));
-        self.cand.extend_from_slice(&sub.cand);
+        self.add_near(&sub);
         self.far.extend_from_slice(&sub.far);
         self.stats.depth = self.stats.depth.max(sub.depth);
+    }
+
+    /// The near leaves of `t`, in order, after the octree's.
+    fn add_near(&mut self, t: &Subtree) {
+        for &(a, l) in &t.near {
+            self.near.push(&t.cand[a as usize..(a + l) as usize]);
+        }
     }
 
     fn split(&self, p: &Pending, eps: f64) -> Decision {

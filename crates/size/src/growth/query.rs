@@ -43,12 +43,7 @@ impl SurfaceGrowth {
         }
         let idx = (cur.code & IDX_MASK) as usize;
         if cur.code >> KIND_SHIFT == K_NEAR {
-            let (a, l) = self.near[idx];
-            let mut best = self.cap;
-            for &j in &self.cand[a as usize..(a + l) as usize] {
-                best = best.min(self.cone(j, q));
-            }
-            best
+            self.near.min_over(idx, self.cap, |j| self.cone(j, q))
         } else {
             let t = [
                 ((q[0] - cur.lo[0]) / cur.s).clamp(0.0, 1.0),
