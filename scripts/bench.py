@@ -300,10 +300,10 @@ def main():
                              + (" (region)" if last["region_fill"] else "")
                              + (f"; lattice {last['lattice_pct']:.0f} %"
                                 if last["lattice_pct"] is not None else "")
-                             + (f"; peak per process {min(last['rank_peaks']):.0f}-"
-                                f"{max(last['rank_peaks']):.0f} MiB"
+                             + (f"; peak per process {min(last['rank_peaks']):.1f}-"
+                                f"{max(last['rank_peaks']):.1f} MiB"
                                 if last["rank_peaks"] else
-                                f"; peak {last['peak_mib']:.0f} MiB" if "--pieces" in extra
+                                f"; peak {last['peak_mib']:.1f} MiB" if "--pieces" in extra
                                 and last["peak_mib"] is not None else "")])
                 stages = {}
                 for r in runs:
