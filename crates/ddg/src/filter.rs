@@ -1,11 +1,12 @@
 //! The region filter of one part (§7): its walls, the DDG faces between
 //! parts that its edges may not cross, and its points, those the DDG tets
 //! of the part hold.
-use crate::locate::{Bins, Locator};
+use crate::locate::{Bins, Locator, WALK_STEPS};
 use crate::Ddg;
 use parafront_front::{RegionFilter, NO_PLACE};
 use parafront_geom::intersect::{segment_triangle, SegTri};
 use parafront_geom::{Aabb, P3};
+use parafront_mesh::FaceRef;
 use std::sync::atomic::AtomicU32;
 
 /// The DDG faces between tets of different parts, with both parts: the
@@ -95,17 +96,28 @@ pub struct PartFilter<'a> {
     pub k: u32,
     /// The DDG tet of the last point located alone ([`Locator::owner_near`]).
     pub hint: AtomicU32,
+    /// The DDG's face neighbours to walk ([`Ddg::neigh`]), or none where
+    /// they were let go ([`Ddg::let_go_neigh`]).
+    pub neigh: &'a [FaceRef],
 }
 
 impl<'a> PartFilter<'a> {
-    /// The filter of part `k` of partition `part`, with its walls.
-    pub fn new(loc: &'a Locator<'a>, walls: &'a Interfaces, part: &'a [u32], k: u32) -> Self {
+    /// The filter of part `k` of partition `part`, with its walls; it
+    /// walks over `neigh` where it is not empty.
+    pub fn new(
+        loc: &'a Locator<'a>,
+        walls: &'a Interfaces,
+        part: &'a [u32],
+        k: u32,
+        neigh: &'a [FaceRef],
+    ) -> Self {
         PartFilter {
             loc,
             walls,
             part,
             k,
             hint: AtomicU32::new(u32::MAX),
+            neigh,
         }
     }
 }
@@ -117,13 +129,17 @@ impl RegionFilter for PartFilter<'_> {
     fn edge_ok(&self, a: P3, b: P3) -> bool {
         !self.walls.crosses(self.k, a, b)
     }
-    /// The place is the DDG tet that holds `p` strictly: one of `near`,
-    /// else the last tet found, else the bins. Walks from `near` would
-    /// hold the DDG's face neighbours through the fronts
-    /// ([`Ddg::let_go_neigh`]), and saved no time (sphere_1e6 at 8 parts).
+    /// The place is the DDG tet that holds `p` strictly: a walk from one
+    /// of `near` (only `near` itself without the face neighbours), else
+    /// the last tet found, else the bins.
     fn locate(&self, p: P3, near: &[u32]) -> (bool, u32) {
-        if let Some(&t) = near.iter().find(|&&t| self.loc.holds_alone(t, p)) {
-            return (self.part[t as usize] == self.k, t);
+        for (i, &t) in near.iter().enumerate() {
+            if near[..i].contains(&t) {
+                continue;
+            }
+            if let Some(t) = self.loc.walk(self.neigh, t, p, WALK_STEPS) {
+                return (self.part[t as usize] == self.k, t);
+            }
         }
         let (own, strict) = self.loc.owner_placed(p, self.part, &self.hint);
         (own == Some(self.k), strict.unwrap_or(NO_PLACE))

@@ -2,6 +2,7 @@
 //! lowest part among them.
 use crate::Ddg;
 use parafront_geom::{cross, dot, orient3d, sub, Aabb, P3};
+use parafront_mesh::FaceRef;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU32, Ordering};
 
@@ -378,10 +379,47 @@ impl<'a> Locator<'a> {
     /// Whether `t` is a tet id (a hint may be `u32::MAX`) that holds `p`
     /// strictly.
     #[inline]
-    pub(crate) fn holds_alone(&self, t: u32, p: P3) -> bool {
+    fn holds_alone(&self, t: u32, p: P3) -> bool {
         (t as usize) < self.d.tets.len()
             && self.in_box(t, self.grid.at(p))
             && self.strictly_holds(t, p)
+    }
+
+    /// The tet that holds `p` strictly, found by walking from tet `t`
+    /// through the face neighbours `neigh` ([`Ddg::neigh`]) towards `p`
+    /// (across the first face that has `p` outside), over at most `steps`
+    /// tets; `None` where the walk ends otherwise: on a face, outside the
+    /// DDG, out of steps, or off an empty `neigh` (a let-go table: then
+    /// only `t` itself is tried).
+    pub(crate) fn walk(&self, neigh: &[FaceRef], mut t: u32, p: P3, steps: usize) -> Option<u32> {
+        for _ in 0..steps {
+            if t as usize >= self.d.tets.len() {
+                return None;
+            }
+            let q = self.corners(t);
+            let mut strict = true;
+            let mut exit = None;
+            for k in 0..4 {
+                // Face k is opposite corner k.
+                let mut r = q;
+                r[k] = p;
+                let o = orient3d(r[0], r[1], r[2], r[3]);
+                if o < 0.0 {
+                    exit = Some(k);
+                    break;
+                }
+                strict &= o > 0.0;
+            }
+            let Some(k) = exit else {
+                return strict.then_some(t);
+            };
+            let n = *neigh.get(4 * t as usize + k)?;
+            if n.is_none() {
+                return None;
+            }
+            t = n.tet().idx() as u32;
+        }
+        None
     }
 
     /// [`Locator::owner`], trying first the tet in `hint` (the last one
@@ -470,11 +508,18 @@ impl<'a> Locator<'a> {
     /// The lowest part among the DDG tets touching `p` (§8), or `None`
     /// outside the DDG. `hint` is a tet near `p` (or `u32::MAX`), updated
     /// to the tet found holding `p` strictly (else `u32::MAX`): the answer
-    /// does not depend on it. Walks from it through the face neighbours
-    /// saved no time (sphere_5e6 at 32 parts), and would hold them.
-    pub fn lowest_host(&self, p: P3, part: &[u32], hint: &mut u32) -> Option<u32> {
-        if self.holds_alone(*hint, p) {
-            return Some(part[*hint as usize]);
+    /// does not depend on it. A walk from it over `neigh` ([`Ddg::neigh`],
+    /// or none) goes first.
+    pub fn lowest_host(
+        &self,
+        neigh: &[FaceRef],
+        p: P3,
+        part: &[u32],
+        hint: &mut u32,
+    ) -> Option<u32> {
+        if let Some(t) = self.walk(neigh, *hint, p, WALK_STEPS) {
+            *hint = t;
+            return Some(part[t as usize]);
         }
         *hint = u32::MAX;
         let mut lo: Option<u32> = None;
@@ -489,6 +534,9 @@ impl<'a> Locator<'a> {
         lo
     }
 }
+
+/// Tets a walk from a nearby point's tet visits before the bins decide.
+pub(crate) const WALK_STEPS: usize = 4;
 
 #[cfg(test)]
 mod tests {
@@ -560,7 +608,7 @@ mod tests {
             assert_eq!(Some(l), parts.iter().min().copied(), "vertex {v}");
             assert_eq!(
                 Some(l),
-                loc.lowest_host(d.points[v], &part, &mut u32::MAX.clone())
+                loc.lowest_host(&d.neigh(), d.points[v], &part, &mut u32::MAX.clone())
             );
             mixed += usize::from(parts.iter().any(|&k| k != l));
         }
@@ -579,6 +627,7 @@ mod tests {
         let part: Vec<u32> = (0..d.tets.len() as u32).map(|t| (t / 7) % 5).collect();
         let hint = AtomicU32::new(u32::MAX);
         let mut lo_hint = u32::MAX;
+        let neigh = d.neigh();
         let (mut inside, mut outside, mut shared) = (0, 0, 0);
         for p in probes(d) {
             let want = brute(d, p);
@@ -598,7 +647,7 @@ mod tests {
             );
             let lowest = parts.iter().min().copied();
             assert_eq!(
-                loc.lowest_host(p, &part, &mut lo_hint),
+                loc.lowest_host(&neigh, p, &part, &mut lo_hint),
                 lowest,
                 "lowest {p:?}"
             );
@@ -619,45 +668,55 @@ mod tests {
         );
     }
 
-    /// The part filter's `locate`, from any hints, answers as `point_ok`,
-    /// and the place it gives holds the point strictly, without the DDG's
-    /// face neighbours; `edge_ok_at` answers as `edge_ok`.
+    /// The part filter's `locate`, from any hints, with the face
+    /// neighbours to walk or without them, answers as `point_ok`, and the
+    /// place it gives holds the point strictly; a walk ends only at such a
+    /// tet; `edge_ok_at` answers as `edge_ok`.
     #[test]
     fn hinted_location_answers_as_the_bins() {
         let d = torus_ddg();
         let loc = Locator::new(&d);
         let part: Vec<u32> = (0..d.tets.len() as u32).map(|t| (t / 7) % 5).collect();
         let walls = Interfaces::new(&d, &part, 0..5);
-        d.let_go_neigh();
-        let f = PartFilter::new(&loc, &walls, &part, 2);
+        let neigh = d.neigh().to_vec();
         let probes = probes(&d);
         let n = d.tets.len() as u32;
-        let mut placed = 0;
-        let mut at = Vec::new();
-        for (i, &p) in probes.iter().enumerate() {
-            // Hints: the host of the previous probe, a tet far off, none.
-            let near = [
-                at.last().copied().unwrap_or(NO_PLACE),
-                (i as u32 * 7919) % n,
-                NO_PLACE,
-            ];
-            let (ok, t) = f.locate(p, &near);
-            assert_eq!(ok, f.point_ok(p), "locate {p:?}");
-            if t != NO_PLACE {
-                assert!(loc.strictly_holds(t, p), "place of {p:?}");
-                placed += 1;
+        for table in [&neigh[..], &[]] {
+            let f = PartFilter::new(&loc, &walls, &part, 2, table);
+            let (mut walked, mut placed) = (0, 0);
+            let mut at = Vec::new();
+            for (i, &p) in probes.iter().enumerate() {
+                // Hints: the host of the previous probe, a tet far off, none.
+                let near = [
+                    at.last().copied().unwrap_or(NO_PLACE),
+                    (i as u32 * 7919) % n,
+                    NO_PLACE,
+                ];
+                let (ok, t) = f.locate(p, &near);
+                assert_eq!(ok, f.point_ok(p), "locate {p:?}");
+                if t != NO_PLACE {
+                    assert!(loc.strictly_holds(t, p), "place of {p:?}");
+                    placed += 1;
+                }
+                for &h in &near[..2] {
+                    if let Some(w) = loc.walk(table, h, p, WALK_STEPS) {
+                        assert!(loc.strictly_holds(w, p), "walk to {p:?}");
+                        walked += 1;
+                    }
+                }
+                at.push(t);
             }
-            at.push(t);
-        }
-        assert!(placed > 1000, "{placed}");
-        assert!(!d.holds_neigh(), "the filter asked for the neighbours");
-        for i in 1..probes.len() {
-            let (a, b) = (probes[i - 1], probes[i]);
-            assert_eq!(f.edge_ok_at(a, at[i - 1], b, at[i]), f.edge_ok(a, b));
-            // The short edge inside the place of `a`.
-            let c = [0, 1, 2].map(|k| 0.9 * a[k] + 0.1 * b[k]);
-            let tc = f.locate(c, &[at[i - 1]]).1;
-            assert_eq!(f.edge_ok_at(a, at[i - 1], c, tc), f.edge_ok(a, c));
+            // Without the table a walk only tries its first tet.
+            let walks = if table.is_empty() { 0 } else { 100 };
+            assert!(walked >= walks && placed > 1000, "{walked} {placed}");
+            for i in 1..probes.len() {
+                let (a, b) = (probes[i - 1], probes[i]);
+                assert_eq!(f.edge_ok_at(a, at[i - 1], b, at[i]), f.edge_ok(a, b));
+                // The short edge inside the place of `a`.
+                let c = [0, 1, 2].map(|k| 0.9 * a[k] + 0.1 * b[k]);
+                let tc = f.locate(c, &[at[i - 1]]).1;
+                assert_eq!(f.edge_ok_at(a, at[i - 1], c, tc), f.edge_ok(a, c));
+            }
         }
     }
 

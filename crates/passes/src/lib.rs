@@ -44,6 +44,7 @@ use parafront_front::{
     advance, Everywhere, FrontError, FrontInput, FrontOptions, RegionFilter, SizeMode,
 };
 use parafront_geom::{centroid3, orient3d, tet_volume6, Aabb, P3};
+use parafront_mesh::FaceRef;
 use rayon::prelude::*;
 use rustc_hash::FxHashMap;
 use std::time::Instant;
@@ -387,6 +388,15 @@ struct DdgRegions<'a> {
     walls: Interfaces,
     part_of: &'a [u32],
     cells: reach::PartCells,
+    /// The DDG's face neighbours the filters walk, or none.
+    neigh: &'a [FaceRef],
+}
+
+/// Whether this process lets the DDG's face neighbours go while its fronts
+/// run: it holds only some of the parts (an MPI rank), whose passes set its
+/// peak.
+fn let_go_neigh<C: Comm>(comm: &C) -> bool {
+    comm.owned().len() < comm.parts()
 }
 
 impl Regions for DdgRegions<'_> {
@@ -414,7 +424,13 @@ impl Regions for DdgRegions<'_> {
         self.cells.meets(k, &b.inflated(ext))
     }
     fn filter(&self, k: u32) -> Box<dyn RegionFilter + '_> {
-        Box::new(PartFilter::new(self.loc, &self.walls, self.part_of, k))
+        Box::new(PartFilter::new(
+            self.loc,
+            &self.walls,
+            self.part_of,
+            k,
+            self.neigh,
+        ))
     }
 }
 
@@ -569,7 +585,16 @@ pub fn passes_around<C: Comm>(
     // §8 step 4.
     let t0 = Instant::now();
     part::add_core_tets(&mut parts, (points, point_size), core_tets);
-    let dst = redistribute::destinations(&parts, comm.owned().start, &loc, &on.base);
+    // Walks where the face neighbours are held; an MPI rank, which let
+    // them go, does not rebuild them for this.
+    let held = d.holds_neigh().then(|| d.neigh());
+    let dst = redistribute::destinations(
+        &parts,
+        comm.owned().start,
+        (&loc, held.as_deref().unwrap_or(&[])),
+        &on.base,
+    );
+    drop(held);
     // The DDG, its locator and its partitions are done with before the
     // tets move: they were 30 MB of each MPI rank's peak on sphere_5e6,
     // which redistribution set. `redistribute` returns their memory to

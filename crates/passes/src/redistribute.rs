@@ -7,7 +7,7 @@ use crate::{PackedTets, ParOutput, Part, PassError};
 use parafront_comm::{Comm, Wire, WireError};
 use parafront_ddg::Locator;
 use parafront_geom::{Aabb, P3};
-use parafront_mesh::TET_FACES;
+use parafront_mesh::{FaceRef, TET_FACES};
 use rayon::prelude::*;
 use rustc_hash::FxHashMap;
 
@@ -297,7 +297,7 @@ fn agreed<C: Comm, T>(comm: &C, r: Result<T, PassError>) -> Result<T, PassError>
 pub(crate) fn destinations(
     parts: &[Part],
     start: usize,
-    loc: &Locator,
+    (loc, neigh): (&Locator, &[FaceRef]),
     part0: &[u32],
 ) -> Vec<Dests> {
     let at_inputs = loc.lowest_at_inputs(part0);
@@ -307,8 +307,8 @@ pub(crate) fn destinations(
         .map(|(i, part)| {
             let k = start + i;
             // Each point's lowest part, and the DDG tet that holds it
-            // strictly where one does: a tet's next corner tries it first
-            // (the points' own order jumps about).
+            // strictly where one does: a walk for a tet's next corner
+            // starts there (the points' own order jumps about).
             let mut host: Vec<Option<u32>> = vec![None; part.pts.len()];
             let mut place = vec![u32::MAX; part.pts.len()];
             let dst: Vec<u32> = part
@@ -331,13 +331,13 @@ pub(crate) fn destinations(
                                 Some(&low) if low != u32::MAX => {
                                     debug_assert_eq!(
                                         Some(low),
-                                        loc.lowest_host(p, part0, &mut u32::MAX.clone())
+                                        loc.lowest_host(neigh, p, part0, &mut u32::MAX.clone())
                                     );
                                     low
                                 }
                                 _ => {
                                     let mut at = hint;
-                                    let low = loc.lowest_host(p, part0, &mut at);
+                                    let low = loc.lowest_host(neigh, p, part0, &mut at);
                                     if at != u32::MAX {
                                         (place[i], hint) = (at, at);
                                     }

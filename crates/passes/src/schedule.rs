@@ -228,20 +228,31 @@ impl<C: Comm> Passes<'_, C> {
     ) -> Result<(), PassError> {
         // Partition work before it counts in `partition_seconds`, not here.
         let t0 = Instant::now();
+        let walls = Interfaces::new(self.d, part_of, {
+            let r = self.comm.owned();
+            r.start as u32..r.end as u32
+        });
+        let cells = crate::reach::PartCells::new(self.d, part_of, self.comm.parts());
+        // A process that holds only some of the parts (an MPI rank) lets
+        // the DDG's face neighbours go while its fronts run, which set its
+        // peak (3.3 MB of sphere_5e6's 77 MiB at 32 parts on 4 ranks); the
+        // next partition rebuilds them. One that holds them all walks them
+        // (without, its passes took 7 % longer on sphere_1e6).
+        let held = if let_go_neigh(self.comm) {
+            self.d.let_go_neigh();
+            crate::release(self.opts.release);
+            None
+        } else {
+            Some(self.d.neigh())
+        };
         let regions = DdgRegions {
             d: self.d,
             loc: self.loc,
-            walls: Interfaces::new(self.d, part_of, {
-                let r = self.comm.owned();
-                r.start as u32..r.end as u32
-            }),
+            walls,
             part_of,
-            cells: crate::reach::PartCells::new(self.d, part_of, self.comm.parts()),
+            cells,
+            neigh: held.as_deref().unwrap_or(&[]),
         };
-        // The fronts do not walk the DDG: its face neighbours are rebuilt
-        // when the next partition or §8 asks for them.
-        self.d.let_go_neigh();
-        crate::release(self.opts.release);
         let size = Sizes::fine(self.size);
         let (tets, secs) = parallel_pass(
             parts,
