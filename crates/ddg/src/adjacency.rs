@@ -1,7 +1,8 @@
-//! The DDG's face neighbours, let go while §7's fronts run and rebuilt
-//! from the tets when next asked. Only the partitions, their shifts and
-//! walls (§6, §7) read them; on an MPI rank they were 3.3 MB of a peak
-//! set by the fronts (sphere_5e6, 4 ranks).
+//! The DDG's face neighbours, which an MPI rank lets go while its §7
+//! fronts run, rebuilt from the tets when next asked. The partitions,
+//! their shifts and walls (§6, §7) read them, and the point location
+//! walks them where they are held; on an MPI rank they were 3.3 MB of a
+//! peak set by the fronts (sphere_5e6, 4 ranks).
 use crate::Ddg;
 use parafront_mesh::{face_neighbours, FaceRef, PointId};
 use std::ops::Deref;
@@ -71,7 +72,7 @@ impl Ddg {
     }
 
     /// Frees the face neighbours until [`neigh`](Self::neigh) is next
-    /// asked (§7's fronts locate points in the bins, not by walks).
+    /// asked (the fronts then locate points without walks).
     pub fn let_go_neigh(&self) {
         let mut w = self
             .adjacency
@@ -92,10 +93,7 @@ mod tests {
     /// A let-go table is rebuilt as it was, and held again until let go.
     #[test]
     fn the_neighbours_come_back_as_they_were() {
-        let s = parafront_surface::generate::icosphere([0.0; 3], 1.0, 2);
-        let faces: Vec<[u32; 3]> = s.tris.iter().map(|t| [t[0], t[2], t[1]]).collect();
-        let d = crate::build(s.points.clone(), s.mean_edge_lengths(), faces, 1.6)
-            .expect("the DDG of a sphere");
+        let d = crate::ddg_of(&parafront_surface::generate::icosphere([0.0; 3], 1.0, 2));
         let before = d.neigh().to_vec();
         assert_eq!(before.len(), 4 * d.tets.len());
         assert!(d.holds_neigh());

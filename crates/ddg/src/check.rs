@@ -24,11 +24,7 @@ mod tests {
 
     #[test]
     fn a_built_ddg_passes_and_each_fault_is_named() {
-        let s = parafront_surface::generate::icosphere([0.0; 3], 1.0, 2);
-        // The front's faces point into the region: the triangles turned.
-        let faces: Vec<[u32; 3]> = s.tris.iter().map(|t| [t[0], t[2], t[1]]).collect();
-        let d = crate::build(s.points.clone(), s.mean_edge_lengths(), faces, 1.6)
-            .expect("the DDG of a sphere");
+        let d = crate::ddg_of(&parafront_surface::generate::icosphere([0.0; 3], 1.0, 2));
         assert!(d.tets.len() > 100);
         assert!(d.check().is_ok());
         let fr = d

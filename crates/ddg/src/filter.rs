@@ -15,8 +15,8 @@ use std::sync::atomic::AtomicU32;
 #[derive(Clone, Debug)]
 pub struct Interfaces {
     bins: Bins,
-    /// The walls, their boxes taken when asked (kept, they were a third
-    /// of the walls' memory).
+    /// The walls; their boxes are taken when asked, not kept (they were a
+    /// third of the walls' memory).
     faces: Vec<[P3; 3]>,
     pub(crate) sides: Vec<[u32; 2]>,
     held: std::ops::Range<u32>,

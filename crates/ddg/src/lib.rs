@@ -147,6 +147,21 @@ impl Ddg {
     }
 }
 
+/// The DDG of the closed surface `s` at the default growth, its
+/// triangles turned (the front's faces point into the region): for the
+/// tests.
+#[cfg(test)]
+pub(crate) fn ddg_of(s: &parafront_surface::Surface) -> Ddg {
+    let faces: Vec<[u32; 3]> = s.tris.iter().map(|t| [t[0], t[2], t[1]]).collect();
+    build(
+        s.points.clone(),
+        s.mean_edge_lengths(),
+        faces,
+        DEFAULT_GROWTH,
+    )
+    .expect("the DDG of a closed surface")
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -155,9 +170,7 @@ mod tests {
     #[test]
     fn the_ddg_of_a_sphere_is_coarse_inside_and_keeps_the_surface() {
         let s = generate::icosphere([0.0; 3], 1.0, 3);
-        let faces: Vec<[u32; 3]> = s.tris.iter().map(|t| [t[0], t[2], t[1]]).collect();
-        let h = s.mean_edge_lengths();
-        let d = build(s.points.clone(), h, faces, DEFAULT_GROWTH).unwrap();
+        let d = ddg_of(&s);
         let n_new = d.points.len() - d.n_input;
         // §5: about as many extra points as surface points, or fewer.
         assert!(

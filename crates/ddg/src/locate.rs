@@ -547,10 +547,7 @@ mod tests {
 
     /// The DDG of a torus: not convex, so points of its box fall outside.
     fn torus_ddg() -> Ddg {
-        let s = generate::torus([0.0; 3], 1.0, 0.35, 24, 12);
-        let faces: Vec<[u32; 3]> = s.tris.iter().map(|t| [t[0], t[2], t[1]]).collect();
-        let h = s.mean_edge_lengths();
-        crate::build(s.points.clone(), h, faces, crate::DEFAULT_GROWTH).unwrap()
+        crate::ddg_of(&generate::torus([0.0; 3], 1.0, 0.35, 24, 12))
     }
 
     /// Every tet whose closure holds `p`, ascending, by a scan of all tets.

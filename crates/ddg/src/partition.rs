@@ -491,20 +491,8 @@ mod tests {
     use super::*;
     use parafront_surface::generate;
 
-    /// The DDG of a closed surface (its front: the triangles reversed).
-    fn ddg_of(s: &parafront_surface::Surface) -> Ddg {
-        let faces: Vec<[u32; 3]> = s.tris.iter().map(|t| [t[0], t[2], t[1]]).collect();
-        crate::build(
-            s.points.clone(),
-            s.mean_edge_lengths(),
-            faces,
-            crate::DEFAULT_GROWTH,
-        )
-        .unwrap()
-    }
-
     fn sphere_ddg() -> Ddg {
-        ddg_of(&generate::icosphere([0.0; 3], 1.0, 3))
+        crate::ddg_of(&generate::icosphere([0.0; 3], 1.0, 3))
     }
 
     #[test]
@@ -523,7 +511,7 @@ mod tests {
     }
 
     fn torus_ddg() -> Ddg {
-        ddg_of(&generate::torus([0.0; 3], 1.0, 0.4, 48, 20))
+        crate::ddg_of(&generate::torus([0.0; 3], 1.0, 0.4, 48, 20))
     }
 
     #[test]
