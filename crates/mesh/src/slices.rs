@@ -9,7 +9,7 @@ use rayon::prelude::*;
 use std::ops::Range;
 
 /// Slices a table is built in, about.
-const SLICES: usize = 8;
+pub(crate) const SLICES: usize = 8;
 /// Fewer items than this are one slice.
 const MIN_SLICE: usize = 1 << 16;
 /// Tets per work item.
@@ -43,10 +43,16 @@ pub(crate) struct Slices {
 impl Slices {
     /// A tet has `per_rank[i]` items at most whose slice is that of its
     /// i-th smallest id (faces by smallest vertex: 3 and 1; edges: 3, 2
-    /// and 1); tets that repeat an id have none unless `repeats`.
-    pub(crate) fn new(tets: &[[PointId; 4]], per_rank: [u32; 3], repeats: bool) -> Slices {
+    /// and 1); tets that repeat an id have none unless `repeats`. About
+    /// `slices` slices.
+    pub(crate) fn new(
+        tets: &[[PointId; 4]],
+        per_rank: [u32; 3],
+        repeats: bool,
+        slices: usize,
+    ) -> Slices {
         let total = tets.len() * per_rank.iter().sum::<u32>() as usize;
-        let ranges = id_ranges(tets, total, per_rank);
+        let ranges = id_ranges(tets, total, per_rank, slices);
         let ns = ranges.len();
         // The slice of each id below the last range's start, by table.
         let last = ranges.last().map_or(0, |r| r.start) as usize;
@@ -134,10 +140,15 @@ impl Slices {
     }
 }
 
-/// The ranges of ids that split `total` items into about [`SLICES`]
+/// The ranges of ids that split `total` items into about `slices`
 /// slices of equal size; a tet has `per_rank[i]` items by its i-th
 /// smallest id.
-fn id_ranges(tets: &[[PointId; 4]], total: usize, per_rank: [u32; 3]) -> Vec<Range<u32>> {
+fn id_ranges(
+    tets: &[[PointId; 4]],
+    total: usize,
+    per_rank: [u32; 3],
+    slices: usize,
+) -> Vec<Range<u32>> {
     if total <= MIN_SLICE {
         return std::iter::once(0..u32::MAX).collect();
     }
@@ -170,8 +181,8 @@ fn id_ranges(tets: &[[PointId; 4]], total: usize, per_rank: [u32; 3]) -> Vec<Ran
             a
         })
         .unwrap_or_default();
-    let per = (total / SLICES).max(MIN_SLICE);
-    let mut out = Vec::with_capacity(SLICES + 1);
+    let per = (total / slices.max(1)).max(MIN_SLICE);
+    let mut out = Vec::with_capacity(slices + 1);
     let (mut lo, mut acc) = (0u32, 0usize);
     for (v, &c) in counts.iter().enumerate() {
         acc += c as usize;
