@@ -286,18 +286,21 @@ mod tests {
         assert_eq!(find_triple(&keys, [5, 6, 8]).len(), 0);
     }
 
+    fn xorshift(mut x: u64) -> impl FnMut() -> u64 {
+        move || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            x
+        }
+    }
+
     /// `sort_keys` gives `sort_unstable`'s order, fill slots last: ids
     /// narrow (the counting sort, serial and in parallel runs) and spread
     /// (the fallback).
     #[test]
     fn sort_keys_is_a_sort() {
-        let mut x = 11u64;
-        let mut rng = move || {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
-            x
-        };
+        let mut rng = xorshift(11);
         for threads in [1, 3] {
             let pool = rayon::ThreadPoolBuilder::new()
                 .num_threads(threads)
@@ -312,7 +315,7 @@ mod tests {
             ] {
                 let mut keys: Vec<u128> = (0..n)
                     .map(|i| {
-                        if rng() % 7 == 0 {
+                        if rng().is_multiple_of(7) {
                             return u128::MAX;
                         }
                         let a = 1000 + (rng() % span) as u32;
@@ -332,13 +335,8 @@ mod tests {
     /// The slices, in order, are the whole sorted table.
     #[test]
     fn slices_make_the_whole_table() {
-        let mut x = 7u64;
-        let mut rng = move || {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
-            (x >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut bits = xorshift(7);
+        let mut rng = move || (bits() >> 11) as f64 / (1u64 << 53) as f64;
         for n in [1usize, 100, 40_000, 90_000] {
             let np = (n / 3).max(4) as u32;
             let tets: Vec<[PointId; 4]> = (0..n)
