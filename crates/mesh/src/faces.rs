@@ -75,8 +75,10 @@ pub(crate) fn for_each_key_slice(
 ) {
     // A face's smallest vertex is the tet's smallest (three faces) unless
     // the face is the one opposite it (its smallest is the tet's second).
-    // Twice the slices of other tables: `sort_keys` holds two buffers.
-    let sl = Slices::new(tets, [3, 1, 0], false, 2 * crate::slices::SLICES);
+    // Slices half the size of other tables': `sort_keys` holds two
+    // buffers (an MPI rank's peak comes in its pieces' adjacency).
+    use crate::slices::{MIN_SLICE, SLICES};
+    let sl = Slices::new(tets, [3, 1, 0], false, (2 * SLICES, MIN_SLICE / 2));
     let mut keys: Vec<u128> = Vec::new();
     let mut scratch: Vec<u128> = Vec::new();
     for (k, r) in sl.ranges.iter().enumerate() {
@@ -361,7 +363,7 @@ mod tests {
             assert_eq!(next, u32::MAX);
             assert_eq!(got, whole, "{n} tets");
             assert!((1..=2 * crate::slices::SLICES + 1).contains(&slices));
-            if 4 * n > 2 * (1 << 16) {
+            if 4 * n > 2 * (1 << 15) {
                 assert!(slices > 1, "{n} tets in one slice");
             }
         }

@@ -142,7 +142,12 @@ pub fn for_each_edge_size_ratio(
     let np = mesh.points.len();
     // An edge's smaller id is a tet's smallest (three edges), second (two)
     // or third (one); a repeating tet has fewer edges.
-    let sl = crate::slices::Slices::new(&mesh.tets, [3, 2, 1], true, crate::slices::SLICES);
+    let sl = crate::slices::Slices::new(
+        &mesh.tets,
+        [3, 2, 1],
+        true,
+        (crate::slices::SLICES, crate::slices::MIN_SLICE),
+    );
     let mut edges: Vec<u64> = Vec::new();
     let mut ratios: Vec<f64> = Vec::new();
     for k in 0..sl.ranges.len() {

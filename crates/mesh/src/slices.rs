@@ -11,7 +11,7 @@ use std::ops::Range;
 /// Slices a table is built in, about.
 pub(crate) const SLICES: usize = 8;
 /// Fewer items than this are one slice.
-const MIN_SLICE: usize = 1 << 16;
+pub(crate) const MIN_SLICE: usize = 1 << 16;
 /// Tets per work item.
 const CHUNK: usize = 4096;
 
@@ -44,15 +44,15 @@ impl Slices {
     /// A tet has `per_rank[i]` items at most whose slice is that of its
     /// i-th smallest id (faces by smallest vertex: 3 and 1; edges: 3, 2
     /// and 1); tets that repeat an id have none unless `repeats`. About
-    /// `slices` slices.
+    /// `slices` slices of at least `min_slice` items.
     pub(crate) fn new(
         tets: &[[PointId; 4]],
         per_rank: [u32; 3],
         repeats: bool,
-        slices: usize,
+        (slices, min_slice): (usize, usize),
     ) -> Slices {
         let total = tets.len() * per_rank.iter().sum::<u32>() as usize;
-        let ranges = id_ranges(tets, total, per_rank, slices);
+        let ranges = id_ranges(tets, total, per_rank, (slices, min_slice));
         let ns = ranges.len();
         // The slice of each id below the last range's start, by table.
         let last = ranges.last().map_or(0, |r| r.start) as usize;
@@ -141,15 +141,15 @@ impl Slices {
 }
 
 /// The ranges of ids that split `total` items into about `slices`
-/// slices of equal size; a tet has `per_rank[i]` items by its i-th
-/// smallest id.
+/// slices of equal size, at least `min_slice` each; a tet has
+/// `per_rank[i]` items by its i-th smallest id.
 fn id_ranges(
     tets: &[[PointId; 4]],
     total: usize,
     per_rank: [u32; 3],
-    slices: usize,
+    (slices, min_slice): (usize, usize),
 ) -> Vec<Range<u32>> {
-    if total <= MIN_SLICE {
+    if total <= min_slice {
         return std::iter::once(0..u32::MAX).collect();
     }
     // A valid mesh has fewer points than 4 ids per tet; ids past that (a
@@ -181,7 +181,7 @@ fn id_ranges(
             a
         })
         .unwrap_or_default();
-    let per = (total / slices.max(1)).max(MIN_SLICE);
+    let per = (total / slices.max(1)).max(min_slice.max(1));
     let mut out = Vec::with_capacity(slices + 1);
     let (mut lo, mut acc) = (0u32, 0usize);
     for (v, &c) in counts.iter().enumerate() {

@@ -81,6 +81,11 @@ pub struct ParOptions {
     /// Merge the pieces into one mesh on part 0's process (true), or leave
     /// them where they are (a partitioned output, memory distributed).
     pub gather: bool,
+    /// With `gather`: whether the caller keeps the pieces beside the
+    /// merged mesh. Their tet numbers, owners and shared points are found
+    /// only then (or without `gather`); a merged run whose improvement
+    /// renumbers the mesh drops them.
+    pub keep_pieces: bool,
     /// Hands freed memory back to the system (the CLI: glibc's
     /// `malloc_trim`), called once the DDG is split and after each part's
     /// front; `None` leaves it to the allocator.
@@ -106,6 +111,7 @@ impl Default for ParOptions {
             ddg_cap: ddg_build::DDG_CAP,
             fail_part: None,
             gather: true,
+            keep_pieces: true,
             release: None,
         }
     }

@@ -149,6 +149,35 @@ fn a_sphere_on_2_4_8_parts() {
     }
 }
 
+/// A merged run that drops its pieces gets the same mesh without their
+/// tet numbers, owners and shared points; one that keeps them has them.
+#[test]
+fn pieces_not_kept_skip_their_lists_and_merge_the_same() {
+    let s = generate::torus([0.0; 3], 1.0, 0.4, 48, 20);
+    let out = |keep_pieces| {
+        let opts = ParOptions {
+            parts: 4,
+            keep_pieces,
+            ..ParOptions::default()
+        };
+        run_opts(&s, 0.1, &opts).unwrap()
+    };
+    let (kept, dropped) = (out(true), out(false));
+    check(&s, &dropped);
+    assert_eq!(bits(&kept.points), bits(&dropped.points));
+    assert_eq!(kept.tets, dropped.tets);
+    assert_eq!(kept.tet_pass, dropped.tet_pass);
+    assert!(kept
+        .pieces
+        .iter()
+        .all(|pc| pc.tet_gid.len() == pc.tets.len()));
+    assert!(kept.pieces.iter().any(|pc| !pc.neighbours.is_empty()));
+    for pc in &dropped.pieces {
+        assert!(pc.tet_gid.is_empty() && pc.owner.is_empty());
+        assert!(pc.neighbours.is_empty() && pc.shared.is_empty());
+    }
+}
+
 #[test]
 fn the_mesh_does_not_depend_on_the_threads() {
     let s = generate::torus([0.0; 3], 1.0, 0.4, 48, 20);

@@ -32,6 +32,10 @@ pub(crate) fn mesh_parts<C: Comm>(
     let mut next_base = s.points.len() as u32;
     // The lattice's inner points, for improvement to leave alone.
     let mut lattice_inner = Vec::new();
+    // Improvement renumbers the merged mesh, so its pieces would go
+    // stale; they are a second copy of the mesh (13 of sphere_1e6's 77 MB
+    // peak, which came in the improvement).
+    let kept = !opts.gather || opts.optimize == 0;
     let popts = ParOptions {
         parts: opts.parts,
         growth: if opts.ddg_growth > 0.0 {
@@ -49,6 +53,7 @@ pub(crate) fn mesh_parts<C: Comm>(
         ddg_cap: opts.ddg_cap,
         fail_part: opts.fail_part,
         gather: opts.gather,
+        keep_pieces: kept,
         release: opts.release_memory,
         ..ParOptions::default()
     };
@@ -190,10 +195,6 @@ pub(crate) fn mesh_parts<C: Comm>(
         } else {
             None
         };
-        // Improvement renumbers the merged mesh, so its pieces would go
-        // stale; they are a second copy of the mesh (13 of sphere_1e6's
-        // 77 MB peak, which came in the improvement).
-        let kept = !opts.gather || opts.optimize == 0;
         if let Some(base) = pieces_base.filter(|_| kept) {
             keep_pieces(sum, rf, base, out.pieces, comm.parts());
         }
