@@ -20,8 +20,33 @@ pub const SAMPLES: usize = 5;
 /// Relative tolerance of the volume comparison.
 pub const VOLUME_RTOL: f64 = 1e-9;
 
-/// Tets or points per work item of the parallel checks.
+/// Items per work item of the parallel checks.
 const CHECK_CHUNK: usize = 1 << 14;
+
+/// `item(acc, i, x)` over every `x = items[i]`, chunk by chunk in
+/// parallel, each chunk into its own `new()`, the chunks merged in order:
+/// the result does not depend on the threads (float sums included), and
+/// no accumulator moves per item (rayon's `fold` moved one per tet, a
+/// tenth of the check).
+fn over_chunks<T: Sync, A: Send>(
+    items: &[T],
+    new: impl Fn() -> A + Sync,
+    item: impl Fn(&mut A, usize, &T) + Sync,
+    merge: impl Fn(A, A) -> A,
+) -> A {
+    let accs: Vec<A> = items
+        .par_chunks(CHECK_CHUNK)
+        .enumerate()
+        .map(|(c, ch)| {
+            let mut acc = new();
+            for (i, x) in ch.iter().enumerate() {
+                item(&mut acc, c * CHECK_CHUNK + i, x);
+            }
+            acc
+        })
+        .collect();
+    accs.into_iter().fold(new(), merge)
+}
 
 /// What a successful check measured.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -305,24 +330,19 @@ impl TetMesh {
 
     /// Every point finite.
     fn check_points(&self) -> Found {
-        let found: Vec<Found> = self
-            .points
-            .par_chunks(CHECK_CHUNK)
-            .enumerate()
-            .map(|(c, ch)| {
-                let mut acc = Found::default();
-                for (i, p) in ch.iter().enumerate() {
-                    if !p.iter().all(|x| x.is_finite()) {
-                        acc.push(MeshProblem::NonFinitePoint {
-                            point: PointId::new(c * CHECK_CHUNK + i),
-                            coords: *p,
-                        });
-                    }
+        over_chunks(
+            &self.points,
+            Found::default,
+            |acc, i, p| {
+                if !p.iter().all(|x| x.is_finite()) {
+                    acc.push(MeshProblem::NonFinitePoint {
+                        point: PointId::new(i),
+                        coords: *p,
+                    });
                 }
-                acc
-            })
-            .collect();
-        found.into_iter().fold(Found::default(), Found::merge)
+            },
+            Found::merge,
+        )
     }
 
     /// Tets: ids, repeats, exact orientation, volume; and the points no
@@ -333,64 +353,55 @@ impl TetMesh {
             .into_par_iter()
             .map(|_| AtomicBool::new(false))
             .collect();
-        // Chunks of tets, merged in order: the volume's sum is the same
-        // whatever the threads, and no accumulator moves per tet (those
-        // moves were a tenth of the check).
-        let new_acc = || TetAcc {
-            found: Found::default(),
-            vol6: 0.0,
-            min_vol6: f64::INFINITY,
-        };
-        let accs: Vec<TetAcc> = self
-            .tets
-            .par_chunks(CHECK_CHUNK)
-            .enumerate()
-            .map(|(c, ch)| {
-                let mut acc = new_acc();
-                for (i, tet) in ch.iter().enumerate() {
-                    let tid = TetId::new(c * CHECK_CHUNK + i);
-                    let mut in_range = true;
-                    for &p in tet {
-                        if p.idx() < np {
-                            used[p.idx()].store(true, Relaxed);
-                        } else {
-                            in_range = false;
-                            acc.found.push(MeshProblem::PointOutOfRange {
-                                tet: tid,
-                                point: p,
-                                n_points: np,
-                            });
-                        }
-                    }
-                    if has_repeat(tet) {
-                        acc.found.push(MeshProblem::RepeatedVertex {
+        let ta = over_chunks(
+            &self.tets,
+            || TetAcc {
+                found: Found::default(),
+                vol6: 0.0,
+                min_vol6: f64::INFINITY,
+            },
+            |acc, t, tet| {
+                let tid = TetId::new(t);
+                let mut in_range = true;
+                for &p in tet {
+                    if p.idx() < np {
+                        used[p.idx()].store(true, Relaxed);
+                    } else {
+                        in_range = false;
+                        acc.found.push(MeshProblem::PointOutOfRange {
                             tet: tid,
-                            verts: *tet,
+                            point: p,
+                            n_points: np,
                         });
-                    } else if in_range {
-                        let c = self.tet_points(tid);
-                        let v6 = tet_volume6(c[0], c[1], c[2], c[3]);
-                        acc.vol6 += v6.abs();
-                        acc.min_vol6 = acc.min_vol6.min(v6);
-                        if finite_ok && orient3d(c[0], c[1], c[2], c[3]) <= 0.0 {
-                            acc.found.push(MeshProblem::NotPositive {
-                                tet: tid,
-                                verts: *tet,
-                                coords: c,
-                                volume6: v6,
-                                flat: orient3d(c[0], c[1], c[2], c[3]) == 0.0,
-                            });
-                        }
                     }
                 }
-                acc
-            })
-            .collect();
-        let ta = accs.into_iter().fold(new_acc(), |a, b| TetAcc {
-            found: a.found.merge(b.found),
-            vol6: a.vol6 + b.vol6,
-            min_vol6: a.min_vol6.min(b.min_vol6),
-        });
+                if has_repeat(tet) {
+                    acc.found.push(MeshProblem::RepeatedVertex {
+                        tet: tid,
+                        verts: *tet,
+                    });
+                } else if in_range {
+                    let c = self.tet_points(tid);
+                    let v6 = tet_volume6(c[0], c[1], c[2], c[3]);
+                    acc.vol6 += v6.abs();
+                    acc.min_vol6 = acc.min_vol6.min(v6);
+                    if finite_ok && orient3d(c[0], c[1], c[2], c[3]) <= 0.0 {
+                        acc.found.push(MeshProblem::NotPositive {
+                            tet: tid,
+                            verts: *tet,
+                            coords: c,
+                            volume6: v6,
+                            flat: orient3d(c[0], c[1], c[2], c[3]) == 0.0,
+                        });
+                    }
+                }
+            },
+            |a, b| TetAcc {
+                found: a.found.merge(b.found),
+                vol6: a.vol6 + b.vol6,
+                min_vol6: a.min_vol6.min(b.min_vol6),
+            },
+        );
         let n_unused_points = used.par_iter().filter(|u| !u.load(Relaxed)).count();
         (ta, n_unused_points)
     }
@@ -603,41 +614,35 @@ impl TetMesh {
 
 /// The input triangles, validated, as sorted keys (low = index).
 fn input_keys(tris: &[[u32; 3]], np: usize) -> (Found, Vec<u128>) {
-    let (f, mut keys) = tris
-        .par_iter()
-        .enumerate()
-        .fold(
-            || (Found::default(), Vec::new()),
-            |(mut f, mut keys), (i, t)| {
-                if let Some(&p) = t.iter().find(|&&p| p as usize >= np) {
-                    f.push(MeshProblem::BadInputTriangle {
-                        tri: i,
-                        verts: *t,
-                        why: if p == u32::MAX {
-                            "uses point id u32::MAX"
-                        } else {
-                            "uses a point id past the end of the points"
-                        },
-                    });
-                } else if t[0] == t[1] || t[1] == t[2] || t[0] == t[2] {
-                    f.push(MeshProblem::BadInputTriangle {
-                        tri: i,
-                        verts: *t,
-                        why: "repeats a vertex",
-                    });
-                } else {
-                    keys.push(pack(sort3(*t).0, i as u32));
-                }
-                (f, keys)
-            },
-        )
-        .reduce(
-            || (Found::default(), Vec::new()),
-            |(fa, mut ka), (fb, kb)| {
-                ka.extend(kb);
-                (fa.merge(fb), ka)
-            },
-        );
+    let (f, mut keys) = over_chunks(
+        tris,
+        || (Found::default(), Vec::new()),
+        |(f, keys), i, t| {
+            if let Some(&p) = t.iter().find(|&&p| p as usize >= np) {
+                f.push(MeshProblem::BadInputTriangle {
+                    tri: i,
+                    verts: *t,
+                    why: if p == u32::MAX {
+                        "uses point id u32::MAX"
+                    } else {
+                        "uses a point id past the end of the points"
+                    },
+                });
+            } else if t[0] == t[1] || t[1] == t[2] || t[0] == t[2] {
+                f.push(MeshProblem::BadInputTriangle {
+                    tri: i,
+                    verts: *t,
+                    why: "repeats a vertex",
+                });
+            } else {
+                keys.push(pack(sort3(*t).0, i as u32));
+            }
+        },
+        |(fa, mut ka), (fb, kb)| {
+            ka.extend(kb);
+            (fa.merge(fb), ka)
+        },
+    );
     crate::faces::sort_unstable(&mut keys);
     (f, keys)
 }

@@ -481,8 +481,9 @@ fn mesh_sized<C: Comm>(
         // (sphere_5e6: 8 MB of every process, through the improvement).
         // Pieces are checked against each region's volume, taken now: the
         // fronts' faces go once their passes are done (sphere_5e6: 1.4 MB
-        // of each MPI rank through redistribution and improvement).
-        let vol6 = volume6(s, &fronts);
+        // of each MPI rank through redistribution and improvement). A
+        // merged mesh is checked against the surface instead.
+        let pieces_vol6 = (!opts.gather).then(|| volume6(s, &fronts));
         let (inner, sizing) = mesh_parts(
             s,
             &mut fronts,
@@ -493,7 +494,7 @@ fn mesh_sized<C: Comm>(
             comm,
             passes_around,
         )?;
-        if !opts.gather {
+        if let Some(vol6) = pieces_vol6 {
             return finish_pieces(s, (&fronts, vol6), sizing, opts, comm, &inner, sum).map(Some);
         }
         opts.release();
